@@ -1,0 +1,85 @@
+// floedem command line. Exit codes: 0 done; 1 unexpected error; 2 bad input (scenario,
+// options, engine settings); 3 output could not be written; 4 the solver failed.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "engine/registry.hpp"
+#include "io/recorder.hpp"
+#include "run/simulation.hpp"
+#include "scenario/scenario.hpp"
+#include "scene/input_error.hpp"
+#include "version.hpp"
+
+namespace {
+
+std::string default_output(const std::string& scenario, const std::string& engine) {
+  return std::filesystem::path(scenario).stem().string() + "." + engine + ".h5";
+}
+
+int run_command(const std::string& scenario_path, const std::string& engine, std::string output,
+                const std::vector<std::string>& overrides, bool quiet) {
+  using namespace floedem;
+  const Scene scene = load_scenario(scenario_path, overrides);
+  if (output.empty()) output = default_output(scenario_path, engine);
+  RunOptions options;
+  options.engine = engine;
+  options.output = output;
+  options.progress = !quiet;
+  const RunSummary summary = run_scene(scene, options);
+  if (!quiet) std::cout << format_summary(scene, summary, output);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"floedem: planar non-smooth DEM of icebergs drifting or towed through broken sea ice"};
+  app.set_version_flag("--version", std::string(floedem::kFloedemVersion));
+  app.require_subcommand(1);
+
+  std::string scenario, engine = "native", output;
+  std::vector<std::string> overrides;
+  bool quiet = false;
+  CLI::App* run = app.add_subcommand("run", "run a scenario on one engine and write its HDF5 output");
+  run->add_option("scenario", scenario, "scenario file (TOML), see scenarios/README.md")->required();
+  std::string engine_names;
+  for (const auto& e : floedem::engines()) engine_names += (engine_names.empty() ? "" : "|") + e.name;
+  run->add_option("--engine,-e", engine, "engine: " + engine_names)->capture_default_str();
+  run->add_option("--out,-o", output, "output file (default: SCENARIO_STEM.ENGINE.h5 in the current directory)");
+  run->add_option("--set,-s", overrides,
+                  "override a scalar of the scenario, KEY=VALUE (e.g. run.duration=60, body[2].density=917); repeatable")
+      ->allow_extra_args(false);
+  run->add_flag("--quiet,-q", quiet, "no progress line and no summary");
+
+  CLI::App* list = app.add_subcommand("engines", "list the engines this build has");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+
+  try {
+    if (list->parsed()) {
+      for (const auto& e : floedem::engines()) std::cout << e.name << "\t" << e.description << "\n";
+      return 0;
+    }
+    return run_command(scenario, engine, output, overrides, quiet);
+  } catch (const floedem::InputError& e) {
+    std::cerr << "floedem: error: " << e.what() << "\n";
+    return 2;
+  } catch (const floedem::OutputError& e) {
+    std::cerr << "floedem: output error: " << e.what() << "\n";
+    return 3;
+  } catch (const floedem::SolverFailure& e) {
+    std::cerr << "floedem: solver failure: " << e.what() << "\n";
+    return 4;
+  } catch (const std::exception& e) {
+    std::cerr << "floedem: unexpected error: " << e.what() << "\n";
+    return 1;
+  }
+}

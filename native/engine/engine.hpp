@@ -1,0 +1,83 @@
+#pragma once
+// The one interface that the native solver and every reference engine implement alike.
+// Flow: scenario -> Scene -> Engine (built by name from the registry) -> Recorder.
+// An engine owns the dynamics of contact; everything that is not contact (applied loads,
+// later environmental forcing and towing) is computed by shared code and handed to step()
+// as loads, so that engines differ only in how they treat contact.
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "geometry/vec2.hpp"
+#include "scene/scene.hpp"
+
+namespace floedem {
+
+/// State of all bodies, in scene order. Position is the centroid; angle is 0 at t = 0.
+struct BodyStates {
+  std::vector<Vec2> position;          ///< m
+  std::vector<double> angle;           ///< rad
+  std::vector<Vec2> velocity;          ///< m/s
+  std::vector<double> angular_velocity;///< rad/s
+  void resize(std::size_t n) {
+    position.resize(n);
+    angle.resize(n);
+    velocity.resize(n);
+    angular_velocity.resize(n);
+  }
+};
+
+/// Non-contact loads on each body, constant over one step (N at the centroid, N m).
+struct Loads {
+  std::vector<Vec2> force;
+  std::vector<double> torque;
+  bool any = false;  ///< false: every entry is zero and the engine may skip them
+};
+
+enum class ContactKind : std::uint8_t {
+  collision = 0,  ///< approach speed above the collision threshold: Newton restitution
+  resting = 1,    ///< bodies moving together: no bounce
+};
+
+/// One contact point's impulse over the last step. Normal from body_a to body_b; the
+/// impulse normal_impulse * normal + tangent_impulse * perp(normal) acts on body_b, its
+/// opposite on body_a.
+struct ContactRecord {
+  std::int32_t body_a = 0;
+  std::int32_t body_b = 0;
+  Vec2 point;                      ///< m, world, at the start of the step
+  Vec2 normal;                     ///< unit, world
+  double normal_impulse = 0.0;     ///< N s, >= 0
+  double tangent_impulse = 0.0;    ///< N s, along perp(normal) = (-n.y, n.x)
+  double approach_velocity = 0.0;  ///< m/s, normal relative velocity before the step (< 0 approaching)
+  double separation = 0.0;         ///< m, signed gap at the start of the step (< 0 overlapping)
+  ContactKind kind = ContactKind::resting;
+};
+
+/// What an engine says about itself; written into the output's attributes.
+struct EngineInfo {
+  std::string name;
+  std::string version;
+  std::map<std::string, std::string> settings;  ///< every setting in force, as text
+  std::vector<std::string> limitations;         ///< what this engine cannot express
+};
+
+class Engine {
+ public:
+  virtual ~Engine() = default;
+  Engine() = default;
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  /// Advances every body by the scene's dt under the given loads (nullptr: none).
+  virtual void step(const Loads* loads) = 0;
+  /// State after the last step (or the initial state before any).
+  virtual const BodyStates& state() const = 0;
+  /// The contact impulses of the last step.
+  virtual std::span<const ContactRecord> contacts() const = 0;
+  virtual EngineInfo info() const = 0;
+};
+
+}  // namespace floedem

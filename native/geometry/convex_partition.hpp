@@ -1,0 +1,17 @@
+#pragma once
+// Splits a simple polygon into convex parts. The only place CGAL is included: it costs
+// tens of seconds and about a gigabyte of memory per translation unit to compile.
+#include <span>
+#include <vector>
+
+#include "geometry/vec2.hpp"
+
+namespace floedem {
+
+/// Convex parts of a simple counter-clockwise polygon whose union is the polygon.
+/// Uses CGAL's optimal convex partition (Greene 1983; fewest parts) for up to 64 vertices,
+/// and the Hertel-Mehlhorn approximation (at most 4x the optimum) above that.
+/// A convex input is returned as its single part.
+std::vector<std::vector<Vec2>> convex_partition(std::span<const Vec2> ccw_polygon);
+
+}  // namespace floedem

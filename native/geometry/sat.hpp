@@ -1,0 +1,45 @@
+#pragma once
+// Separating-axis test for convex polygons. In the plane the face normals of the two polygons
+// are the only candidate separating axes (Gottschalk et al. 1996; Ericson, "Real-Time
+// Collision Detection", 2005, sec. 5.2.1), so the largest face separation is the exact
+// signed distance when the polygons overlap, and a lower bound on the gap when they do not.
+#include <cstdint>
+#include <limits>
+
+#include "geometry/vec2.hpp"
+
+namespace floedem {
+
+/// A convex counter-clockwise polygon as the narrow phase sees it: world vertices and the
+/// outward unit normal of each edge (edge i runs from vertex i to i + 1).
+struct ConvexView {
+  const Vec2* vertices = nullptr;
+  const Vec2* normals = nullptr;
+  int count = 0;
+};
+
+struct FaceSeparation {
+  int edge = -1;
+  double separation = -std::numeric_limits<double>::infinity();
+};
+
+/// Largest over the edges of `a` of the smallest signed distance of `b`'s vertices to that edge.
+inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView& b) {
+  FaceSeparation best;
+  for (int i = 0; i < a.count; ++i) {
+    const Vec2 n = a.normals[i];
+    const Vec2 v = a.vertices[i];
+    double s = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < b.count; ++j) {
+      const double d = dot(n, b.vertices[j] - v);
+      if (d < s) s = d;
+    }
+    if (s > best.separation) {
+      best.separation = s;
+      best.edge = i;
+    }
+  }
+  return best;
+}
+
+}  // namespace floedem

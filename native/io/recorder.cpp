@@ -1,0 +1,331 @@
+#include "io/recorder.hpp"
+
+#include <H5Cpp.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+namespace floedem {
+
+namespace {
+
+constexpr double kFlushSeconds = 1.0;
+
+/// A dataset that grows along its first dimension: [rows, shape...].
+class Series {
+ public:
+  Series() = default;
+  Series(H5::Group& parent, const std::string& name, const H5::DataType& type, std::vector<hsize_t> row_shape,
+         hsize_t chunk_rows)
+      : type_(type), row_shape_(std::move(row_shape)) {
+    std::vector<hsize_t> dims{0}, maxdims{H5S_UNLIMITED}, chunk{std::max<hsize_t>(chunk_rows, 1)};
+    for (const hsize_t d : row_shape_) {
+      dims.push_back(d);
+      maxdims.push_back(d);
+      chunk.push_back(std::max<hsize_t>(d, 1));
+    }
+    H5::DataSpace space(static_cast<int>(dims.size()), dims.data(), maxdims.data());
+    H5::DSetCreatPropList plist;
+    plist.setChunk(static_cast<int>(chunk.size()), chunk.data());
+    H5Pset_obj_track_times(plist.getId(), false);  // no timestamps: identical runs, identical files
+    dataset_ = parent.createDataSet(name, type_, space, plist);
+  }
+
+  void append(const void* data, hsize_t rows) {
+    if (rows == 0) return;
+    std::vector<hsize_t> dims{rows_ + rows}, start{rows_}, count{rows};
+    for (const hsize_t d : row_shape_) {
+      dims.push_back(d);
+      start.push_back(0);
+      count.push_back(d);
+    }
+    dataset_.extend(dims.data());
+    H5::DataSpace file_space = dataset_.getSpace();
+    file_space.selectHyperslab(H5S_SELECT_SET, count.data(), start.data());
+    H5::DataSpace memory(static_cast<int>(count.size()), count.data());
+    dataset_.write(data, type_, memory, file_space);
+    rows_ += rows;
+  }
+  hsize_t rows() const { return rows_; }
+  H5::DataSet& dataset() { return dataset_; }
+
+ private:
+  H5::DataSet dataset_;
+  H5::DataType type_;
+  std::vector<hsize_t> row_shape_;
+  hsize_t rows_ = 0;
+};
+
+H5::DSetCreatPropList fixed_plist() {
+  H5::DSetCreatPropList plist;
+  H5Pset_obj_track_times(plist.getId(), false);
+  return plist;
+}
+
+template <class T>
+void write_fixed(H5::Group& g, const std::string& name, const H5::DataType& type, const std::vector<T>& data,
+                 std::vector<hsize_t> dims) {
+  H5::DataSpace space(static_cast<int>(dims.size()), dims.data());
+  H5::DataSet ds = g.createDataSet(name, type, space, fixed_plist());
+  if (!data.empty()) ds.write(data.data(), type);
+}
+
+void write_attribute(H5::H5Object& obj, const std::string& name, const std::string& value) {
+  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+  type.setCset(H5T_CSET_UTF8);
+  H5::Attribute a = obj.attrExists(name) ? obj.openAttribute(name) : obj.createAttribute(name, type, H5::DataSpace(H5S_SCALAR));
+  a.write(type, value);
+}
+
+void write_attribute(H5::H5Object& obj, const std::string& name, double value) {
+  H5::Attribute a = obj.attrExists(name) ? obj.openAttribute(name)
+                                          : obj.createAttribute(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(H5S_SCALAR));
+  a.write(H5::PredType::NATIVE_DOUBLE, &value);
+}
+
+H5::EnumType contact_kind_type() {
+  H5::EnumType t(H5::PredType::NATIVE_UINT8);
+  std::uint8_t v = static_cast<std::uint8_t>(ContactKind::collision);
+  t.insert("collision", &v);
+  v = static_cast<std::uint8_t>(ContactKind::resting);
+  t.insert("resting", &v);
+  return t;
+}
+
+std::string join(const std::vector<std::string>& v, const std::string& sep) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+}  // namespace
+
+struct Recorder::Impl {
+  H5::H5File file;
+  std::size_t bodies = 0;
+  // Frames.
+  Series time, position, angle, velocity, angular_velocity;
+  hsize_t frame_chunk = 1;
+  std::vector<double> b_time, b_position, b_angle, b_velocity, b_angular_velocity;
+  hsize_t buffered_frames = 0;
+  // Contacts.
+  Series c_time, c_body_a, c_body_b, c_point, c_normal, c_normal_impulse, c_tangent_impulse, c_approach, c_separation,
+      c_kind;
+  std::vector<double> k_time, k_point, k_normal, k_normal_impulse, k_tangent_impulse, k_approach, k_separation;
+  std::vector<std::int32_t> k_body_a, k_body_b;
+  std::vector<std::uint8_t> k_kind;
+  H5::EnumType kind_type = contact_kind_type();
+  std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
+  bool closed = false;
+
+  void write_buffers() {
+    if (buffered_frames > 0) {
+      time.append(b_time.data(), buffered_frames);
+      position.append(b_position.data(), buffered_frames);
+      angle.append(b_angle.data(), buffered_frames);
+      velocity.append(b_velocity.data(), buffered_frames);
+      angular_velocity.append(b_angular_velocity.data(), buffered_frames);
+      b_time.clear(); b_position.clear(); b_angle.clear(); b_velocity.clear(); b_angular_velocity.clear();
+      buffered_frames = 0;
+    }
+    const hsize_t rows = k_time.size();
+    if (rows > 0) {
+      c_time.append(k_time.data(), rows);
+      c_body_a.append(k_body_a.data(), rows);
+      c_body_b.append(k_body_b.data(), rows);
+      c_point.append(k_point.data(), rows);
+      c_normal.append(k_normal.data(), rows);
+      c_normal_impulse.append(k_normal_impulse.data(), rows);
+      c_tangent_impulse.append(k_tangent_impulse.data(), rows);
+      c_approach.append(k_approach.data(), rows);
+      c_separation.append(k_separation.data(), rows);
+      c_kind.append(k_kind.data(), rows);
+      k_time.clear(); k_body_a.clear(); k_body_b.clear(); k_point.clear(); k_normal.clear();
+      k_normal_impulse.clear(); k_tangent_impulse.clear(); k_approach.clear(); k_separation.clear(); k_kind.clear();
+    }
+  }
+
+  void flush() {
+    write_buffers();
+    file.flush(H5F_SCOPE_GLOBAL);
+    last_flush = std::chrono::steady_clock::now();
+  }
+
+  void maybe_flush() {
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - last_flush).count() >= kFlushSeconds) flush();
+  }
+};
+
+Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo& engine, const RunInfo& run)
+    : impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
+  H5::Exception::dontPrint();
+  try {
+    Impl& d = *impl_;
+    d.file = H5::H5File(partial_path_, H5F_ACC_TRUNC);
+    H5::Group root = d.file.openGroup("/");
+    write_attribute(root, "status", "running");
+    write_attribute(root, "engine", engine.name);
+    write_attribute(root, "engine_version", engine.version);
+    write_attribute(root, "floedem_version", run.floedem_version);
+    write_attribute(root, "scenario", scene.source_text);
+    write_attribute(root, "scenario_path", scene.source_path);
+    write_attribute(root, "overrides", join(scene.overrides, "\n"));
+    write_attribute(root, "dt", scene.run.dt);
+    write_attribute(root, "duration", scene.run.duration);
+    write_attribute(root, "output_every", static_cast<double>(scene.run.output_every));
+    write_attribute(root, "forcing_terms", join(run.forcing_terms, ", "));
+
+    H5::Group eng = d.file.createGroup("/engine");
+    for (const auto& [k, v] : engine.settings) write_attribute(eng, k, v);
+    write_attribute(eng, "limitations", join(engine.limitations, "\n"));
+
+    // Bodies: what does not change.
+    const std::size_t n = scene.bodies.size();
+    d.bodies = n;
+    H5::Group bodies = d.file.createGroup("/bodies");
+    {
+      std::vector<const char*> names;
+      for (const auto& b : scene.bodies) names.push_back(b.name.c_str());
+      H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+      type.setCset(H5T_CSET_UTF8);
+      write_fixed(bodies, "name", type, names, {n});
+    }
+    std::vector<double> mass, inertia, area, thickness, density;
+    std::vector<std::uint8_t> fixed;
+    std::vector<double> vertices;
+    std::vector<std::int64_t> offsets{0};
+    for (const auto& b : scene.bodies) {
+      mass.push_back(b.mass);
+      inertia.push_back(b.inertia);
+      area.push_back(b.area);
+      thickness.push_back(b.thickness);
+      density.push_back(b.density);
+      fixed.push_back(b.fixed ? 1 : 0);
+      for (const Vec2 v : b.local_polygon) {
+        vertices.push_back(v.x);
+        vertices.push_back(v.y);
+      }
+      offsets.push_back(static_cast<std::int64_t>(vertices.size() / 2));
+    }
+    write_fixed(bodies, "mass", H5::PredType::NATIVE_DOUBLE, mass, {n});
+    write_fixed(bodies, "inertia", H5::PredType::NATIVE_DOUBLE, inertia, {n});
+    write_fixed(bodies, "area", H5::PredType::NATIVE_DOUBLE, area, {n});
+    write_fixed(bodies, "thickness", H5::PredType::NATIVE_DOUBLE, thickness, {n});
+    write_fixed(bodies, "density", H5::PredType::NATIVE_DOUBLE, density, {n});
+    write_fixed(bodies, "fixed", H5::PredType::NATIVE_UINT8, fixed, {n});
+    write_fixed(bodies, "polygon_vertices", H5::PredType::NATIVE_DOUBLE, vertices, {vertices.size() / 2, 2});
+    write_fixed(bodies, "polygon_offsets", H5::PredType::NATIVE_INT64, offsets, {n + 1});
+
+    // Frames: chunks of about 64 K values, so that tiny scenes do not pay per-frame overhead.
+    const hsize_t per_frame = 2 * std::max<std::size_t>(n, 1);
+    d.frame_chunk = std::clamp<hsize_t>(65536 / per_frame, 1, 4096);
+    d.time = Series(root, "time", H5::PredType::NATIVE_DOUBLE, {}, std::max<hsize_t>(d.frame_chunk, 256));
+    d.position = Series(bodies, "position", H5::PredType::NATIVE_DOUBLE, {n, 2}, d.frame_chunk);
+    d.angle = Series(bodies, "angle", H5::PredType::NATIVE_DOUBLE, {n}, d.frame_chunk);
+    d.velocity = Series(bodies, "velocity", H5::PredType::NATIVE_DOUBLE, {n, 2}, d.frame_chunk);
+    d.angular_velocity = Series(bodies, "angular_velocity", H5::PredType::NATIVE_DOUBLE, {n}, d.frame_chunk);
+
+    H5::Group contacts = d.file.createGroup("/contacts");
+    const char* which = scene.output.contacts == ContactOutput::all ? "all"
+                        : scene.output.contacts == ContactOutput::collisions ? "collisions" : "none";
+    write_attribute(contacts, "recorded", which);
+    constexpr hsize_t kc = 4096;
+    d.c_time = Series(contacts, "time", H5::PredType::NATIVE_DOUBLE, {}, kc);
+    d.c_body_a = Series(contacts, "body_a", H5::PredType::NATIVE_INT32, {}, kc);
+    d.c_body_b = Series(contacts, "body_b", H5::PredType::NATIVE_INT32, {}, kc);
+    d.c_point = Series(contacts, "point", H5::PredType::NATIVE_DOUBLE, {2}, kc);
+    d.c_normal = Series(contacts, "normal", H5::PredType::NATIVE_DOUBLE, {2}, kc);
+    d.c_normal_impulse = Series(contacts, "normal_impulse", H5::PredType::NATIVE_DOUBLE, {}, kc);
+    d.c_tangent_impulse = Series(contacts, "tangent_impulse", H5::PredType::NATIVE_DOUBLE, {}, kc);
+    d.c_approach = Series(contacts, "approach_velocity", H5::PredType::NATIVE_DOUBLE, {}, kc);
+    d.c_separation = Series(contacts, "separation", H5::PredType::NATIVE_DOUBLE, {}, kc);
+    d.c_kind = Series(contacts, "kind", d.kind_type, {}, kc);
+    d.flush();
+  } catch (const H5::Exception& e) {
+    std::error_code ec;
+    std::filesystem::remove(partial_path_, ec);
+    throw OutputError(partial_path_ + ": cannot create output file (" + e.getDetailMsg() +
+                      "); is the directory there and writable?");
+  }
+}
+
+Recorder::~Recorder() {
+  // A run that did not finish: keep what was recorded, readable, under the .partial name.
+  if (impl_ && !impl_->closed) {
+    try {
+      impl_->flush();
+      impl_->file.close();
+    } catch (...) {
+    }
+  }
+}
+
+void Recorder::write_frame(double time, const BodyStates& state) {
+  Impl& d = *impl_;
+  d.b_time.push_back(time);
+  for (std::size_t i = 0; i < d.bodies; ++i) {
+    d.b_position.push_back(state.position[i].x);
+    d.b_position.push_back(state.position[i].y);
+    d.b_angle.push_back(state.angle[i]);
+    d.b_velocity.push_back(state.velocity[i].x);
+    d.b_velocity.push_back(state.velocity[i].y);
+    d.b_angular_velocity.push_back(state.angular_velocity[i]);
+  }
+  ++d.buffered_frames;
+  try {
+    if (d.buffered_frames >= d.frame_chunk) d.write_buffers();
+    d.maybe_flush();
+  } catch (const H5::Exception& e) {
+    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full?");
+  }
+}
+
+void Recorder::write_contacts(double time, std::span<const ContactRecord> contacts) {
+  Impl& d = *impl_;
+  for (const ContactRecord& c : contacts) {
+    d.k_time.push_back(time);
+    d.k_body_a.push_back(c.body_a);
+    d.k_body_b.push_back(c.body_b);
+    d.k_point.push_back(c.point.x);
+    d.k_point.push_back(c.point.y);
+    d.k_normal.push_back(c.normal.x);
+    d.k_normal.push_back(c.normal.y);
+    d.k_normal_impulse.push_back(c.normal_impulse);
+    d.k_tangent_impulse.push_back(c.tangent_impulse);
+    d.k_approach.push_back(c.approach_velocity);
+    d.k_separation.push_back(c.separation);
+    d.k_kind.push_back(static_cast<std::uint8_t>(c.kind));
+  }
+  try {
+    if (d.k_time.size() >= 4096) d.write_buffers();
+  } catch (const H5::Exception& e) {
+    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full?");
+  }
+}
+
+std::int64_t Recorder::frames() const {
+  return static_cast<std::int64_t>(impl_->time.rows() + impl_->buffered_frames);
+}
+std::int64_t Recorder::contact_rows() const {
+  return static_cast<std::int64_t>(impl_->c_time.rows() + impl_->k_time.size());
+}
+
+void Recorder::finish(const std::vector<std::pair<std::string, double>>& summary) {
+  Impl& d = *impl_;
+  try {
+    H5::Group root = d.file.openGroup("/");
+    for (const auto& [k, v] : summary) write_attribute(root, "summary_" + k, v);
+    write_attribute(root, "status", "complete");
+    d.flush();
+    d.file.close();
+    d.closed = true;
+  } catch (const H5::Exception& e) {
+    throw OutputError(partial_path_ + ": could not complete the file (" + e.getDetailMsg() + "); disk full?");
+  }
+  if (std::rename(partial_path_.c_str(), path_.c_str()) != 0)
+    throw OutputError(partial_path_ + ": cannot rename to " + path_ + ": " + std::strerror(errno));
+}
+
+}  // namespace floedem

@@ -1,0 +1,51 @@
+#pragma once
+// HDF5 output of a run (layout in README.md, "Output"). Written as the run goes, under
+// RESULT.h5.partial, flushed at least once a second of wall time so that a killed run keeps
+// its recorded frames readable; renamed to RESULT.h5 by finish() only.
+#include <chrono>
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/engine.hpp"
+#include "scene/scene.hpp"
+
+namespace floedem {
+
+/// Output could not be written (unwritable directory, disk full, ...). Exit code 3.
+class OutputError : public std::runtime_error {
+ public:
+  explicit OutputError(const std::string& m) : std::runtime_error(m) {}
+};
+
+struct RunInfo {
+  std::vector<std::string> forcing_terms;
+  std::string floedem_version;
+};
+
+class Recorder {
+ public:
+  Recorder(const std::string& path, const Scene& scene, const EngineInfo& engine, const RunInfo& run);
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  void write_frame(double time, const BodyStates& state);
+  void write_contacts(double time, std::span<const ContactRecord> contacts);
+  /// Writes what is buffered, marks the file complete, closes it and renames it to `path`.
+  void finish(const std::vector<std::pair<std::string, double>>& summary);
+
+  const std::string& partial_path() const { return partial_path_; }
+  std::int64_t frames() const;
+  std::int64_t contact_rows() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string path_;
+  std::string partial_path_;
+};
+
+}  // namespace floedem

@@ -1,0 +1,137 @@
+#include "run/simulation.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "engine/registry.hpp"
+#include "forcing/force_term.hpp"
+#include "io/recorder.hpp"
+#include "version.hpp"
+
+namespace floedem {
+
+double kinetic_energy(const Scene& scene, const BodyStates& state) {
+  double e = 0.0;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const BodySpec& b = scene.bodies[i];
+    if (b.fixed) continue;
+    e += 0.5 * b.mass * length_squared(state.velocity[i]) +
+         0.5 * b.inertia * state.angular_velocity[i] * state.angular_velocity[i];
+  }
+  return e;
+}
+
+namespace {
+
+bool finite_state(const BodyStates& s) {
+  for (std::size_t i = 0; i < s.position.size(); ++i) {
+    if (!std::isfinite(s.position[i].x) || !std::isfinite(s.position[i].y) || !std::isfinite(s.angle[i]) ||
+        !std::isfinite(s.velocity[i].x) || !std::isfinite(s.velocity[i].y) || !std::isfinite(s.angular_velocity[i]))
+      return false;
+  }
+  return true;
+}
+
+class Progress {
+ public:
+  explicit Progress(bool enabled) : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1) {}
+  void update(std::int64_t step, std::int64_t steps) {
+    if (!enabled_) return;
+    const double elapsed = seconds_since(start_);
+    if (elapsed < 1.0 || seconds_since(last_) < (tty_ ? 0.2 : 10.0)) return;
+    last_ = clock::now();
+    const double left = elapsed * static_cast<double>(steps - step) / static_cast<double>(step);
+    std::fprintf(stderr, "%sstep %lld/%lld (%3.0f%%), %.1f s elapsed, ~%.1f s left%s", tty_ ? "\r" : "",
+                 static_cast<long long>(step), static_cast<long long>(steps),
+                 100.0 * static_cast<double>(step) / static_cast<double>(steps), elapsed, left, tty_ ? "" : "\n");
+    shown_ = true;
+  }
+  void done() {
+    if (shown_ && tty_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  using clock = std::chrono::steady_clock;
+  static double seconds_since(clock::time_point t) { return std::chrono::duration<double>(clock::now() - t).count(); }
+  bool enabled_, tty_;
+  bool shown_ = false;
+  clock::time_point start_ = clock::now();
+  clock::time_point last_ = clock::now() - std::chrono::hours(1);
+};
+
+}  // namespace
+
+RunSummary run_scene(const Scene& scene, const RunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<Engine> engine = make_engine(options.engine, scene);
+  Forcing forcing(scene);
+  RunInfo info;
+  for (const auto name : forcing.names()) info.forcing_terms.emplace_back(name);
+  info.floedem_version = kFloedemVersion;
+  Recorder recorder(options.output, scene, engine->info(), info);
+
+  RunSummary summary;
+  summary.engine = options.engine;
+  const std::int64_t steps = scene.run.steps();
+  const double dt = scene.run.dt;
+  summary.kinetic_energy_start = kinetic_energy(scene, engine->state());
+  recorder.write_frame(0.0, engine->state());
+  Progress progress(options.progress);
+  for (std::int64_t k = 1; k <= steps; ++k) {
+    // Time as k * dt rather than a running sum: no drift over long runs.
+    const double t_start = static_cast<double>(k - 1) * dt;
+    const double t_end = static_cast<double>(k) * dt;
+    engine->step(forcing.evaluate(engine->state(), t_start));
+    const BodyStates& state = engine->state();
+    if (!finite_state(state))
+      throw SolverFailure("non-finite body state at step " + std::to_string(k) + " (t = " + std::to_string(t_end) +
+                          " s); output so far kept in " + recorder.partial_path());
+    const auto contacts = engine->contacts();
+    for (const ContactRecord& c : contacts)
+      ++(c.kind == ContactKind::collision ? summary.collision_impulses : summary.resting_impulses);
+    recorder.write_contacts(t_end, contacts);
+    if (k % scene.run.output_every == 0 || k == steps) recorder.write_frame(t_end, state);
+    progress.update(k, steps);
+  }
+  progress.done();
+  const BodyStates& state = engine->state();
+  summary.steps = steps;
+  summary.kinetic_energy_end = kinetic_energy(scene, state);
+  for (const Vec2 v : state.velocity) summary.max_speed = std::max(summary.max_speed, length(v));
+  summary.frames = recorder.frames();
+  summary.contact_rows = recorder.contact_rows();
+  summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  recorder.finish({{"steps", static_cast<double>(summary.steps)},
+                   {"kinetic_energy_start", summary.kinetic_energy_start},
+                   {"kinetic_energy_end", summary.kinetic_energy_end},
+                   {"collision_impulses", static_cast<double>(summary.collision_impulses)},
+                   {"resting_impulses", static_cast<double>(summary.resting_impulses)}});
+  return summary;
+}
+
+std::string format_summary(const Scene& scene, const RunSummary& s, const std::string& output) {
+  std::size_t fixed = 0;
+  for (const auto& b : scene.bodies) fixed += b.fixed ? 1 : 0;
+  char buf[1024];
+  std::snprintf(buf, sizeof buf,
+                "floedem run: %s on %s\n"
+                "  bodies      %zu (%zu fixed)\n"
+                "  steps       %lld (dt %g s, %g s of model time), %lld frames recorded\n"
+                "  impulses    %lld collision, %lld resting (%lld contact rows recorded)\n"
+                "  kinetic energy %.6g J -> %.6g J; fastest body %.4g m/s\n"
+                "  wall time   %.3f s (%.4f ms per step)\n"
+                "  output      %s\n",
+                scene.source_path.c_str(), s.engine.c_str(), scene.bodies.size(), fixed,
+                static_cast<long long>(s.steps), scene.run.dt, static_cast<double>(s.steps) * scene.run.dt,
+                static_cast<long long>(s.frames), static_cast<long long>(s.collision_impulses),
+                static_cast<long long>(s.resting_impulses), static_cast<long long>(s.contact_rows),
+                s.kinetic_energy_start, s.kinetic_energy_end, s.max_speed, s.wall_seconds,
+                1e3 * s.wall_seconds / static_cast<double>(std::max<std::int64_t>(s.steps, 1)), output.c_str());
+  return buf;
+}
+
+}  // namespace floedem

@@ -1,0 +1,49 @@
+#pragma once
+// The driver: Scene -> Engine -> Recorder, one way. Forcing is evaluated from the engine's
+// state and handed to the engine each step; the recorder sees each step's contacts and every
+// output_every-th state.
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+#include "scene/scene.hpp"
+
+namespace floedem {
+
+/// The solver produced a non-finite state. Exit code 4.
+class SolverFailure : public std::runtime_error {
+ public:
+  explicit SolverFailure(const std::string& m) : std::runtime_error(m) {}
+};
+
+struct RunOptions {
+  std::string engine = "native";
+  std::string output;          ///< RESULT.h5
+  bool progress = false;       ///< progress line on stderr for runs longer than a second
+};
+
+struct RunSummary {
+  std::string engine;
+  std::int64_t steps = 0;
+  std::int64_t frames = 0;
+  std::int64_t collision_impulses = 0;
+  std::int64_t resting_impulses = 0;
+  std::int64_t contact_rows = 0;
+  double kinetic_energy_start = 0.0;  ///< J, translational + rotational, moving bodies
+  double kinetic_energy_end = 0.0;
+  double max_speed = 0.0;             ///< m/s, largest centroid speed at the end
+  double wall_seconds = 0.0;
+};
+
+/// Runs the scene and writes its output; throws InputError (bad engine settings, before any
+/// file is made), OutputError, SolverFailure.
+RunSummary run_scene(const Scene& scene, const RunOptions& options);
+
+/// Multi-line human summary.
+std::string format_summary(const Scene& scene, const RunSummary& s, const std::string& output);
+
+/// Translational plus rotational kinetic energy of the moving bodies.
+double kinetic_energy(const Scene& scene, const struct BodyStates& state);
+
+}  // namespace floedem

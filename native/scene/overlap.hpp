@@ -1,0 +1,19 @@
+#pragma once
+#include <cstddef>
+#include <optional>
+
+#include "scene/scene.hpp"
+
+namespace floedem {
+
+struct BodyOverlap {
+  std::size_t a = 0;
+  std::size_t b = 0;
+  double depth = 0.0;  ///< m, penetration along the separating axis of least overlap
+};
+
+/// The first pair of bodies (in index order of a) whose polygons overlap at t = 0 by more
+/// than round-off (touching is allowed). Sweep and prune on x, exact SAT on convex parts.
+std::optional<BodyOverlap> find_overlap(const Scene& scene);
+
+}  // namespace floedem

@@ -1,0 +1,186 @@
+#include "solver/contact_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+// Contact constraint, per point, between bodies a and b (normal n from a to b, tangent t = k x n):
+//
+//   relative velocity   u = (v_b + w_b k x r_b) - (v_a + w_a k x r_a),  u_n = u.n, u_t = u.t
+//   Jacobian (normal)   J_n = [-n, -(r_a x n), n, (r_b x n)]  (same with t for friction)
+//   impulse             P = P_n n + P_t t on b, -P on a
+//   Delassus block      W = J M^-1 J^T:
+//       W_nn = 1/m_a + 1/m_b + (r_a x n)^2 / I_a + (r_b x n)^2 / I_b
+//       W_tt = 1/m_a + 1/m_b + (r_a x t)^2 / I_a + (r_b x t)^2 / I_b
+//       W_nt = (r_a x n)(r_a x t) / I_a + (r_b x n)(r_b x t) / I_b
+//   so that u+ = u_free + W (P_n, P_t). The effective mass along n is 1 / W_nn.
+//
+// Conditions (Moreau 1988; Jean 1999, "The non-smooth contact dynamics method"; Glocker and
+// Pfeiffer 1995 for the impact law with friction in the plane):
+//   normal:   P_n >= 0,  u_n+ - u* >= 0,  P_n (u_n+ - u*) = 0,
+//             u* = -e u_n-  for a collision (Newton's law on the approach velocity u_n- before
+//             the step), u* = -max(gap, 0)/dt for a resting contact (no bounce; closes a
+//             speculative gap exactly, never further);
+//   friction: |P_t| <= mu P_n; |P_t| < mu P_n => u_t+ = 0; u_t+ != 0 => P_t = -mu P_n sign(u_t+).
+// solve_single_contact() solves this 2x2 problem exactly by enumerating its cases (separate,
+// stick, slide either way); Gauss-Seidel over the points then converges to the multi-contact
+// solution (Jean's NSCD / Catto's sequential impulses with a block-exact local solver).
+
+namespace floedem {
+
+LocalImpulse solve_single_contact(double ufn, double uft, double target, double mu, double wnn, double wnt,
+                                  double wtt) {
+  const double need = target - ufn;  // normal velocity change wanted
+  if (need <= 0.0) return {};        // separating (or already fast enough): no impulse
+  if (mu <= 0.0) return {need / wnn, 0.0};
+
+  // Stick: u_n+ = u*, u_t+ = 0  =>  W (P_n, P_t) = (need, -u_t).
+  const double det = wnn * wtt - wnt * wnt;
+  const double pn_stick = (wtt * need + wnt * uft) / det;
+  const double pt_stick = (-wnn * uft - wnt * need) / det;
+  if (pn_stick >= 0.0 && std::abs(pt_stick) <= mu * pn_stick) return {pn_stick, pt_stick};
+
+  // Slide with final slip direction s (= sign u_t+): P_t = -s mu P_n, and
+  // (W_nn - s mu W_nt) P_n = need; consistent if P_n >= 0 and s u_t+ >= 0.
+  const double first = pt_stick > 0.0 ? -1.0 : 1.0;  // friction saturates on the side stick wanted
+  const double scale = std::abs(uft) + std::abs(need);
+  for (const double s : {first, -first}) {
+    const double denom = wnn - s * mu * wnt;
+    if (denom <= 0.0) continue;
+    const double pn = need / denom;
+    const double ut = uft + (wnt - s * mu * wtt) * pn;
+    if (s * ut >= -1e-14 * scale) return {pn, -s * mu * pn};
+  }
+  // No consistent case (Painleve-like configurations with strong coupling): the frictionless
+  // normal impulse with friction clamped to the cone.
+  const double pn = need / wnn;
+  const double pt = std::clamp(-(uft + wnt * pn) / wtt, -mu * pn, mu * pn);
+  return {pn, pt};
+}
+
+void prepare_contacts(std::span<Manifold> manifolds, const BodyArrays& s, double dt, double collision_threshold) {
+  for (Manifold& m : manifolds) {
+    const int a = m.body_a, b = m.body_b;
+    const Vec2 n = m.normal;
+    const Vec2 t = perp(n);
+    const double ma = s.inv_mass[a], mb = s.inv_mass[b];
+    const double ia = s.inv_inertia[a], ib = s.inv_inertia[b];
+    for (int k = 0; k < m.point_count; ++k) {
+      ManifoldPoint& p = m.points[k];
+      p.ra = p.point - s.position[a];
+      p.rb = p.point - s.position[b];
+      const double rna = cross(p.ra, n), rnb = cross(p.rb, n);
+      const double rta = cross(p.ra, t), rtb = cross(p.rb, t);
+      p.wnn = ma + mb + ia * rna * rna + ib * rnb * rnb;
+      p.wtt = ma + mb + ia * rta * rta + ib * rtb * rtb;
+      p.wnt = ia * rna * rta + ib * rnb * rtb;
+      p.approach_velocity = dot(relative_velocity(s, a, b, p.ra, p.rb), n);
+      const double gap = std::max(p.separation, 0.0);
+      // A collision: approaching faster than the threshold and reaching contact within the step.
+      if (p.approach_velocity < -collision_threshold && gap + dt * p.approach_velocity < 0.0) {
+        p.kind = ContactKind::collision;
+        // Newton's law; with e = 0 the bodies still close a speculative gap exactly.
+        p.target_velocity = std::max(-m.restitution * p.approach_velocity, -gap / dt);
+      } else {
+        p.kind = ContactKind::resting;
+        p.target_velocity = -gap / dt;
+      }
+    }
+  }
+}
+
+namespace {
+
+inline void apply_impulse(BodyArrays& s, const Manifold& m, const ManifoldPoint& p, Vec2 impulse) {
+  const int a = m.body_a, b = m.body_b;
+  s.velocity[a] -= s.inv_mass[a] * impulse;
+  s.angular_velocity[a] -= s.inv_inertia[a] * cross(p.ra, impulse);
+  s.velocity[b] += s.inv_mass[b] * impulse;
+  s.angular_velocity[b] += s.inv_inertia[b] * cross(p.rb, impulse);
+}
+
+}  // namespace
+
+void warm_start(std::span<const Manifold> manifolds, BodyArrays& s) {
+  for (const Manifold& m : manifolds) {
+    const Vec2 t = perp(m.normal);
+    for (int k = 0; k < m.point_count; ++k) {
+      const ManifoldPoint& p = m.points[k];
+      if (p.normal_impulse != 0.0 || p.tangent_impulse != 0.0)
+        apply_impulse(s, m, p, p.normal_impulse * m.normal + p.tangent_impulse * t);
+    }
+  }
+}
+
+int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, int max_iterations, double tolerance) {
+  int sweep = 0;
+  while (sweep < max_iterations) {
+    ++sweep;
+    double largest_change = 0.0;
+    double largest_impulse = 0.0;
+    for (Manifold& m : manifolds) {
+      const Vec2 n = m.normal;
+      const Vec2 t = perp(n);
+      for (int k = 0; k < m.point_count; ++k) {
+        ManifoldPoint& p = m.points[k];
+        const Vec2 u = relative_velocity(s, m.body_a, m.body_b, p.ra, p.rb);
+        const double pn0 = p.normal_impulse, pt0 = p.tangent_impulse;
+        // Velocity without this point's own impulse.
+        const double ufn = dot(u, n) - (p.wnn * pn0 + p.wnt * pt0);
+        const double uft = dot(u, t) - (p.wnt * pn0 + p.wtt * pt0);
+        const LocalImpulse r = solve_single_contact(ufn, uft, p.target_velocity, m.friction, p.wnn, p.wnt, p.wtt);
+        const double dpn = r.normal - pn0, dpt = r.tangent - pt0;
+        if (dpn != 0.0 || dpt != 0.0) apply_impulse(s, m, p, dpn * n + dpt * t);
+        p.normal_impulse = r.normal;
+        p.tangent_impulse = r.tangent;
+        largest_change = std::max(largest_change, std::abs(dpn) + std::abs(dpt));
+        largest_impulse = std::max(largest_impulse, r.normal + std::abs(r.tangent));
+      }
+    }
+    if (largest_change <= tolerance * largest_impulse) break;
+  }
+  return sweep;
+}
+
+double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const NativeSettings& settings) {
+  double deepest = 0.0;
+  for (int iteration = 0; iteration < settings.position_iterations; ++iteration) {
+    deepest = 0.0;
+    for (const Manifold& m : manifolds) {
+      const int a = m.body_a, b = m.body_b;
+      const int ref = m.reference_is_b ? b : a;
+      const int inc = m.reference_is_b ? a : b;
+      const double ma = s.inv_mass[a], mb = s.inv_mass[b];
+      const double ia = s.inv_inertia[a], ib = s.inv_inertia[b];
+      for (int k = 0; k < m.point_count; ++k) {
+        // Current gap from the material points that made the contact.
+        const Vec2 n_ref = s.rotation[ref].apply(m.local_normal);
+        const Vec2 face = s.position[ref] + s.rotation[ref].apply(m.local_face_point);
+        const Vec2 q = s.position[inc] + s.rotation[inc].apply(m.points[k].local_incident);
+        const double gap = dot(q - face, n_ref);
+        deepest = std::max(deepest, -gap);
+        // C = beta (gap + slop), clamped to [-max_correction, 0]; solve K dlambda = -C with
+        // K = n.M^-1 n at the current configuration, and move positions only.
+        const double c = std::clamp(settings.position_correction * (gap + settings.allowed_penetration),
+                                    -settings.max_correction, 0.0);
+        if (c >= 0.0) continue;
+        const Vec2 n = m.reference_is_b ? -n_ref : n_ref;
+        const Vec2 point = q - 0.5 * gap * n_ref;
+        const Vec2 ra = point - s.position[a];
+        const Vec2 rb = point - s.position[b];
+        const double rna = cross(ra, n), rnb = cross(rb, n);
+        const double k_eff = ma + mb + ia * rna * rna + ib * rnb * rnb;
+        const Vec2 impulse = (-c / k_eff) * n;
+        s.position[a] -= ma * impulse;
+        s.angle[a] -= ia * cross(ra, impulse);
+        s.rotation[a] = Rot::from_angle(s.angle[a]);
+        s.position[b] += mb * impulse;
+        s.angle[b] += ib * cross(rb, impulse);
+        s.rotation[b] = Rot::from_angle(s.angle[b]);
+      }
+    }
+    if (deepest <= 1.5 * settings.allowed_penetration) break;
+  }
+  return deepest;
+}
+
+}  // namespace floedem

@@ -1,0 +1,53 @@
+#pragma once
+// Velocity-level contact impulses (sequential impulses / projected Gauss-Seidel with an exact
+// local solve per contact) and the energy-free position projection.
+#include <span>
+#include <vector>
+
+#include "solver/contact_types.hpp"
+#include "solver/native_settings.hpp"
+
+namespace floedem {
+
+/// Body data the solver reads and writes every step (structure of arrays).
+struct BodyArrays {
+  std::vector<Vec2> position;
+  std::vector<double> angle;
+  std::vector<Rot> rotation;
+  std::vector<Vec2> velocity;
+  std::vector<double> angular_velocity;
+  std::vector<double> inv_mass;
+  std::vector<double> inv_inertia;
+};
+
+/// Relative velocity of the contact point of b with respect to a.
+inline Vec2 relative_velocity(const BodyArrays& s, int a, int b, Vec2 ra, Vec2 rb) {
+  return (s.velocity[b] + cross(s.angular_velocity[b], rb)) - (s.velocity[a] + cross(s.angular_velocity[a], ra));
+}
+
+/// Classifies each point (collision or resting) from its approach velocity and gap, sets its
+/// target normal velocity, and fills the Delassus block.
+void prepare_contacts(std::span<Manifold> manifolds, const BodyArrays& bodies, double dt, double collision_threshold);
+
+/// Applies the accumulated (warm-start) impulses.
+void warm_start(std::span<const Manifold> manifolds, BodyArrays& bodies);
+
+/// Gauss-Seidel sweeps until the largest impulse change is below tolerance times the largest
+/// impulse, or max_iterations. Returns the number of sweeps made.
+int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, int max_iterations, double tolerance);
+
+/// Nonlinear Gauss-Seidel on positions (Box2D v2.4's position solver): pushes overlapping
+/// bodies apart beyond `allowed_penetration`, touching positions only, never velocities, so
+/// that drift correction adds no kinetic energy. Returns the deepest penetration found (m, >= 0).
+double solve_positions(std::span<const Manifold> manifolds, BodyArrays& bodies, const NativeSettings& settings);
+
+/// The exact solution of the single-contact problem (Newton restitution with Coulomb
+/// friction, see contact_solver.cpp). u_free: relative velocity (n, t) without this
+/// contact's impulse; returns the impulse (Pn, Pt).
+struct LocalImpulse {
+  double normal = 0.0;
+  double tangent = 0.0;
+};
+LocalImpulse solve_single_contact(double ufn, double uft, double target, double mu, double wnn, double wnt, double wtt);
+
+}  // namespace floedem

@@ -1,0 +1,40 @@
+#pragma once
+// Contact data of the native solver: manifolds from the narrow phase, carried across steps
+// (accumulated impulses, for warm starting) by their feature ids.
+#include <cstdint>
+
+#include "engine/engine.hpp"
+#include "geometry/vec2.hpp"
+
+namespace floedem {
+
+struct ManifoldPoint {
+  Vec2 point;                  ///< world, midway between the two surfaces
+  double separation = 0.0;     ///< m, signed gap (< 0: overlap)
+  std::uint32_t id = 0;        ///< feature id (reference edge, incident feature): same contact, same id
+  Vec2 local_incident;         ///< the incident polygon's point, in its body's frame (position solve)
+  double normal_impulse = 0.0; ///< N s, accumulated this step (warm start carries it over)
+  double tangent_impulse = 0.0;
+  double approach_velocity = 0.0;  ///< m/s, u.n before the step
+  double target_velocity = 0.0;    ///< m/s, the normal velocity the solve aims at (>=)
+  ContactKind kind = ContactKind::resting;
+  // Velocity-solve data, set by prepare().
+  Vec2 ra, rb;                     ///< lever arms from the centroids
+  double wnn = 0.0, wnt = 0.0, wtt = 0.0;  ///< Delassus block n.M^-1 n etc. (see contact_solver.cpp)
+};
+
+struct Manifold {
+  std::int32_t part_a = 0, part_b = 0;   ///< part_a < part_b
+  std::int32_t body_a = 0, body_b = 0;   ///< body_a < body_b
+  Vec2 normal;                           ///< world, unit, from a to b
+  int point_count = 0;
+  ManifoldPoint points[2];
+  // Reference face in its body's frame, for the position solve.
+  bool reference_is_b = false;
+  Vec2 local_normal;      ///< outward normal of the reference face
+  Vec2 local_face_point;  ///< a vertex of the reference face
+  double friction = 0.0;
+  double restitution = 0.0;
+};
+
+}  // namespace floedem

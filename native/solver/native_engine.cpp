@@ -1,0 +1,278 @@
+// The native planar non-smooth DEM. One step, in order (NativeEngine::step):
+//   1. pairs      bounds fattened by each body's reach this step -> broad phase
+//   2. manifolds  narrow phase per pair, impulses carried over by feature id, contacts classified
+//   3. forces     non-contact loads change velocities (symplectic Euler: v* = v + dt M^-1 F)
+//   4. solve      contact impulses at velocity level (contact_solver.cpp)
+//   5. integrate  x += dt v+, angle += dt w+
+//   6. project    overlap beyond the allowed penetration removed on positions only
+//   7. record     contact impulses of the step, for the recorder
+#include "solver/native_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "solver/broad_phase.hpp"
+#include "solver/contact_solver.hpp"
+#include "solver/narrow_phase.hpp"
+#include "solver/native_settings.hpp"
+
+namespace floedem {
+
+namespace {
+
+class NativeEngine final : public Engine {
+ public:
+  explicit NativeEngine(const Scene& scene);
+  void step(const Loads* loads) override;
+  const BodyStates& state() const override { return state_; }
+  std::span<const ContactRecord> contacts() const override { return records_; }
+  EngineInfo info() const override;
+
+ private:
+  void find_pairs(const Loads* loads);
+  void build_manifolds();
+  void apply_loads(const Loads& loads);
+  void integrate();
+  void record();
+  void publish_state();
+  PartGeometry part_geometry(std::int32_t k) const;
+
+  NativeSettings settings_;
+  ContactSettings contact_;
+  ContactOutput contact_output_;
+  double dt_;
+
+  // Hot: touched every step.
+  BodyArrays bodies_;
+  std::vector<std::int32_t> part_body_;
+  std::vector<std::uint8_t> part_fixed_;
+  std::vector<std::int32_t> part_first_;   // first vertex of part k; part k has part_first_[k+1]-part_first_[k]
+  std::vector<Vec2> local_vertices_, local_normals_;
+  std::vector<Vec2> world_vertices_, world_normals_;
+  std::vector<double> part_radius_;        // largest distance of a vertex from the body's centroid
+  std::vector<double> linear_reach_;       // per body: dt |v| this step
+  std::vector<double> angular_reach_;      // per body: dt |w| this step
+  std::vector<double> part_reach_;         // per part: how far any of its points can move this step
+  std::vector<Aabb> part_boxes_;
+  BroadPhase broad_phase_;
+  std::vector<PartPair> pairs_;
+  std::vector<Manifold> manifolds_, previous_manifolds_;
+  std::vector<ContactRecord> records_;
+  BodyStates state_;
+  int last_sweeps_ = 0;
+};
+
+NativeEngine::NativeEngine(const Scene& scene)
+    : settings_(read_native_settings(scene)),
+      contact_(scene.contact),
+      contact_output_(scene.output.contacts),
+      dt_(scene.run.dt) {
+  const std::size_t n = scene.bodies.size();
+  bodies_.position.resize(n);
+  bodies_.angle.assign(n, 0.0);
+  bodies_.rotation.assign(n, Rot{});
+  bodies_.velocity.resize(n);
+  bodies_.angular_velocity.resize(n);
+  bodies_.inv_mass.resize(n);
+  bodies_.inv_inertia.resize(n);
+  part_first_.push_back(0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodySpec& b = scene.bodies[i];
+    bodies_.position[i] = b.centroid;
+    bodies_.velocity[i] = b.velocity;
+    bodies_.angular_velocity[i] = b.angular_velocity;
+    bodies_.inv_mass[i] = b.fixed ? 0.0 : 1.0 / b.mass;
+    bodies_.inv_inertia[i] = b.fixed ? 0.0 : 1.0 / b.inertia;
+    for (const auto& part : b.local_parts) {
+      double radius = 0.0;
+      const std::size_t m = part.size();
+      for (std::size_t k = 0; k < m; ++k) {
+        local_vertices_.push_back(part[k]);
+        const Vec2 e = part[(k + 1) % m] - part[k];
+        local_normals_.push_back(normalized(Vec2{e.y, -e.x}));
+        radius = std::max(radius, length(part[k]));
+      }
+      part_body_.push_back(static_cast<std::int32_t>(i));
+      part_fixed_.push_back(b.fixed ? 1 : 0);
+      part_first_.push_back(static_cast<std::int32_t>(local_vertices_.size()));
+      part_radius_.push_back(radius);
+    }
+  }
+  world_vertices_.resize(local_vertices_.size());
+  world_normals_.resize(local_normals_.size());
+  part_boxes_.resize(part_body_.size());
+  linear_reach_.resize(n);
+  angular_reach_.resize(n);
+  part_reach_.resize(part_body_.size());
+  publish_state();
+}
+
+EngineInfo NativeEngine::info() const {
+  EngineInfo i;
+  i.name = "native";
+  i.version = "floedem";
+  i.settings = {
+      {"velocity_iterations", std::to_string(settings_.velocity_iterations)},
+      {"tolerance", std::to_string(settings_.tolerance)},
+      {"warm_start", settings_.warm_start ? "true" : "false"},
+      {"position_iterations", std::to_string(settings_.position_iterations)},
+      {"position_correction", std::to_string(settings_.position_correction)},
+      {"allowed_penetration", std::to_string(settings_.allowed_penetration)},
+      {"max_correction", std::to_string(settings_.max_correction)},
+  };
+  return i;
+}
+
+void NativeEngine::step(const Loads* loads) {
+  if (loads && !loads->any) loads = nullptr;  // nothing to add: skip the pass
+  find_pairs(loads);                           // 1. pairs
+  build_manifolds();                           // 2. manifolds, classified on the velocities before the step
+  if (loads) apply_loads(*loads);              // 3. non-contact forces
+  if (!manifolds_.empty()) {                   // 4. contact impulses
+    if (settings_.warm_start) warm_start(manifolds_, bodies_);
+    last_sweeps_ = solve_velocities(manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
+  } else {
+    last_sweeps_ = 0;
+  }
+  integrate();                                 // 5. positions
+  if (settings_.position_iterations > 0 && !manifolds_.empty())
+    solve_positions(manifolds_, bodies_, settings_);  // 6. drift correction, positions only
+  record();                                    // 7. impulses for the recorder
+  publish_state();
+}
+
+void NativeEngine::find_pairs(const Loads* loads) {
+  // Reach: how far any point of a body can travel this step (dt times its speed after the
+  // loads, plus spin times the part's radius), so that contacts are found before the bodies
+  // would overlap (speculative contact) and their bounds need no rebuild within the step.
+  const std::size_t nb = bodies_.position.size();
+  for (std::size_t i = 0; i < nb; ++i) {
+    double speed = length(bodies_.velocity[i]);
+    double spin = std::abs(bodies_.angular_velocity[i]);
+    if (loads) {
+      speed += dt_ * length(loads->force[i]) * bodies_.inv_mass[i];
+      spin += dt_ * std::abs(loads->torque[i]) * bodies_.inv_inertia[i];
+    }
+    linear_reach_[i] = dt_ * speed;
+    angular_reach_[i] = dt_ * spin;
+  }
+  const std::size_t np = part_body_.size();
+  for (std::size_t k = 0; k < np; ++k) {
+    const std::int32_t b = part_body_[k];
+    const Transform x{bodies_.position[b], bodies_.rotation[b]};
+    Aabb box{world_vertices_[0], world_vertices_[0]};
+    for (std::int32_t v = part_first_[k]; v < part_first_[k + 1]; ++v) {
+      const Vec2 p = x.apply(local_vertices_[v]);
+      world_vertices_[v] = p;
+      world_normals_[v] = x.q.apply(local_normals_[v]);
+      if (v == part_first_[k]) box = Aabb{p, p};
+      box.lo.x = std::min(box.lo.x, p.x);
+      box.lo.y = std::min(box.lo.y, p.y);
+      box.hi.x = std::max(box.hi.x, p.x);
+      box.hi.y = std::max(box.hi.y, p.y);
+    }
+    part_reach_[k] = linear_reach_[b] + angular_reach_[b] * part_radius_[k];
+    const double fat = part_reach_[k] + 0.5 * settings_.allowed_penetration;
+    box.lo -= Vec2{fat, fat};
+    box.hi += Vec2{fat, fat};
+    part_boxes_[k] = box;
+  }
+  broad_phase_.find_pairs(part_boxes_, part_body_, part_fixed_, pairs_);
+}
+
+PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
+  const std::int32_t first = part_first_[k];
+  const std::int32_t b = part_body_[k];
+  return PartGeometry{ConvexView{&world_vertices_[first], &world_normals_[first], part_first_[k + 1] - first},
+                      &local_vertices_[first], &local_normals_[first],
+                      Transform{bodies_.position[b], bodies_.rotation[b]}};
+}
+
+void NativeEngine::build_manifolds() {
+  std::swap(manifolds_, previous_manifolds_);
+  manifolds_.clear();
+  std::size_t old = 0;  // both lists are sorted by (part_a, part_b): a merge carries impulses over
+  const double flip_tolerance = 0.1 * settings_.allowed_penetration;
+  for (const PartPair& pair : pairs_) {
+    Manifold m;
+    m.part_a = pair.a;
+    m.part_b = pair.b;
+    m.body_a = part_body_[pair.a];
+    m.body_b = part_body_[pair.b];
+    m.friction = contact_.friction;
+    m.restitution = contact_.restitution;
+    const double margin = part_reach_[pair.a] + part_reach_[pair.b] + settings_.allowed_penetration;
+    collide(part_geometry(pair.a), part_geometry(pair.b), margin, flip_tolerance, m);
+    if (m.point_count == 0) continue;
+    while (old < previous_manifolds_.size() &&
+           PartPair{previous_manifolds_[old].part_a, previous_manifolds_[old].part_b} < pair)
+      ++old;
+    if (settings_.warm_start && old < previous_manifolds_.size() && previous_manifolds_[old].part_a == pair.a &&
+        previous_manifolds_[old].part_b == pair.b) {
+      const Manifold& prev = previous_manifolds_[old];
+      for (int k = 0; k < m.point_count; ++k) {
+        for (int j = 0; j < prev.point_count; ++j) {
+          // Only resting impulses are a good first guess: a collision's impulse is a one-off.
+          if (prev.points[j].id == m.points[k].id && prev.points[j].kind == ContactKind::resting) {
+            m.points[k].normal_impulse = prev.points[j].normal_impulse;
+            m.points[k].tangent_impulse = prev.points[j].tangent_impulse;
+          }
+        }
+      }
+    }
+    manifolds_.push_back(m);
+  }
+  prepare_contacts(manifolds_, bodies_, dt_, contact_.collision_threshold);
+  // A point that is now a collision starts from zero: Newton's law fixes its impulse.
+  for (Manifold& m : manifolds_)
+    for (int k = 0; k < m.point_count; ++k)
+      if (m.points[k].kind == ContactKind::collision) m.points[k].normal_impulse = m.points[k].tangent_impulse = 0.0;
+}
+
+void NativeEngine::apply_loads(const Loads& loads) {
+  const std::size_t nb = bodies_.position.size();
+  for (std::size_t i = 0; i < nb; ++i) {
+    bodies_.velocity[i] += (dt_ * bodies_.inv_mass[i]) * loads.force[i];
+    bodies_.angular_velocity[i] += dt_ * bodies_.inv_inertia[i] * loads.torque[i];
+  }
+}
+
+void NativeEngine::integrate() {
+  const std::size_t nb = bodies_.position.size();
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (bodies_.inv_mass[i] == 0.0) continue;
+    bodies_.position[i] += dt_ * bodies_.velocity[i];
+    if (bodies_.angular_velocity[i] != 0.0) {
+      bodies_.angle[i] += dt_ * bodies_.angular_velocity[i];
+      bodies_.rotation[i] = Rot::from_angle(bodies_.angle[i]);
+    }
+  }
+}
+
+void NativeEngine::record() {
+  records_.clear();
+  if (contact_output_ == ContactOutput::none) return;
+  for (const Manifold& m : manifolds_) {
+    for (int k = 0; k < m.point_count; ++k) {
+      const ManifoldPoint& p = m.points[k];
+      if (p.normal_impulse == 0.0 && p.tangent_impulse == 0.0) continue;
+      if (contact_output_ == ContactOutput::collisions && p.kind != ContactKind::collision) continue;
+      records_.push_back(ContactRecord{m.body_a, m.body_b, p.point, m.normal, p.normal_impulse, p.tangent_impulse,
+                                       p.approach_velocity, p.separation, p.kind});
+    }
+  }
+}
+
+void NativeEngine::publish_state() {
+  state_.position = bodies_.position;
+  state_.angle = bodies_.angle;
+  state_.velocity = bodies_.velocity;
+  state_.angular_velocity = bodies_.angular_velocity;
+}
+
+}  // namespace
+
+std::unique_ptr<Engine> make_native_engine(const Scene& scene) { return std::make_unique<NativeEngine>(scene); }
+
+}  // namespace floedem

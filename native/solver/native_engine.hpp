@@ -1,0 +1,11 @@
+#pragma once
+#include <memory>
+
+#include "engine/engine.hpp"
+
+namespace floedem {
+
+/// floedem's own solver (registered as "native").
+std::unique_ptr<Engine> make_native_engine(const Scene& scene);
+
+}  // namespace floedem

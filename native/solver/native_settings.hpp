@@ -1,0 +1,20 @@
+#pragma once
+#include "scene/scene.hpp"
+
+namespace floedem {
+
+/// [engine.native] settings; defaults and reasons in scenarios/README.md.
+struct NativeSettings {
+  int velocity_iterations = 50;      ///< most Gauss-Seidel sweeps per step
+  double tolerance = 1e-10;          ///< stop sweeping when max |dP| <= tolerance * max |P|
+  bool warm_start = true;            ///< start from last step's resting impulses
+  int position_iterations = 4;       ///< position-projection sweeps per step (0: none)
+  double position_correction = 0.2;  ///< fraction of the overlap removed per sweep
+  double allowed_penetration = 1e-3; ///< m, overlap left alone (keeps contacts persistent)
+  double max_correction = 0.2;       ///< m, largest push of one sweep at one point
+};
+
+/// Reads [engine.native] from the scene (defaults for what is absent); InputError if bad.
+NativeSettings read_native_settings(const Scene& scene);
+
+}  // namespace floedem
