@@ -75,8 +75,11 @@ void prepare_contacts(std::span<Manifold> manifolds, const BodyArrays& s, double
       p.wnt = ia * rna * rta + ib * rnb * rtb;
       p.approach_velocity = dot(relative_velocity(s, a, b, p.ra, p.rb), n);
       const double gap = std::max(p.separation, 0.0);
-      // A collision: approaching faster than the threshold and reaching contact within the step.
-      if (p.approach_velocity < -collision_threshold && gap + dt * p.approach_velocity < 0.0) {
+      // A collision: a new contact, approaching faster than the threshold, reached within the
+      // step. A point that was pressed last step is resting whatever its approach speed: bodies
+      // already in contact do not collide, and their approach speed is solver residual (in a
+      // pressed pack, classifying it as a collision would make the pack bounce in place).
+      if (!p.persistent && p.approach_velocity < -collision_threshold && gap + dt * p.approach_velocity < 0.0) {
         p.kind = ContactKind::collision;
         // Newton's law; with e = 0 the bodies still close a speculative gap exactly.
         p.target_velocity = std::max(-m.restitution * p.approach_velocity, -gap / dt);

@@ -18,6 +18,7 @@ struct ManifoldPoint {
   double approach_velocity = 0.0;  ///< m/s, u.n before the step
   double target_velocity = 0.0;    ///< m/s, the normal velocity the solve aims at (>=)
   ContactKind kind = ContactKind::resting;
+  bool persistent = false;         ///< the same point carried a normal impulse last step
   // Velocity-solve data, set by prepare().
   Vec2 ra, rb;                     ///< lever arms from the centroids
   double wnn = 0.0, wnt = 0.0, wtt = 0.0;  ///< Delassus block n.M^-1 n etc. (see contact_solver.cpp)

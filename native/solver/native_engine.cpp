@@ -37,6 +37,8 @@ class NativeEngine final : public Engine {
   void record();
   void publish_state();
   PartGeometry part_geometry(std::int32_t k) const;
+  void solve_contacts();
+  double contact_kinetic_energy() const;
 
   NativeSettings settings_;
   ContactSettings contact_;
@@ -61,6 +63,9 @@ class NativeEngine final : public Engine {
   std::vector<ContactRecord> records_;
   BodyStates state_;
   int last_sweeps_ = 0;
+  std::int64_t cold_restarts_ = 0;
+  std::vector<Vec2> saved_velocity_;
+  std::vector<double> saved_angular_velocity_;
 };
 
 NativeEngine::NativeEngine(const Scene& scene)
@@ -129,12 +134,7 @@ void NativeEngine::step(const Loads* loads) {
   find_pairs(loads);                           // 1. pairs
   build_manifolds();                           // 2. manifolds, classified on the velocities before the step
   if (loads) apply_loads(*loads);              // 3. non-contact forces
-  if (!manifolds_.empty()) {                   // 4. contact impulses
-    if (settings_.warm_start) warm_start(manifolds_, bodies_);
-    last_sweeps_ = solve_velocities(manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
-  } else {
-    last_sweeps_ = 0;
-  }
+  if (!manifolds_.empty()) solve_contacts();  // 4. contact impulses
   integrate();                                 // 5. positions
   if (settings_.position_iterations > 0 && !manifolds_.empty())
     solve_positions(manifolds_, bodies_, settings_);  // 6. drift correction, positions only
@@ -208,15 +208,19 @@ void NativeEngine::build_manifolds() {
     while (old < previous_manifolds_.size() &&
            PartPair{previous_manifolds_[old].part_a, previous_manifolds_[old].part_b} < pair)
       ++old;
-    if (settings_.warm_start && old < previous_manifolds_.size() && previous_manifolds_[old].part_a == pair.a &&
+    if (old < previous_manifolds_.size() && previous_manifolds_[old].part_a == pair.a &&
         previous_manifolds_[old].part_b == pair.b) {
       const Manifold& prev = previous_manifolds_[old];
       for (int k = 0; k < m.point_count; ++k) {
         for (int j = 0; j < prev.point_count; ++j) {
+          const ManifoldPoint& was = prev.points[j];
+          if (was.id != m.points[k].id) continue;
+          // Pressed last step: the bodies are already in contact here, so this is no collision.
+          m.points[k].persistent = was.normal_impulse > 0.0;
           // Only resting impulses are a good first guess: a collision's impulse is a one-off.
-          if (prev.points[j].id == m.points[k].id && prev.points[j].kind == ContactKind::resting) {
-            m.points[k].normal_impulse = prev.points[j].normal_impulse;
-            m.points[k].tangent_impulse = prev.points[j].tangent_impulse;
+          if (settings_.warm_start && was.kind == ContactKind::resting) {
+            m.points[k].normal_impulse = was.normal_impulse;
+            m.points[k].tangent_impulse = was.tangent_impulse;
           }
         }
       }
@@ -228,6 +232,43 @@ void NativeEngine::build_manifolds() {
   for (Manifold& m : manifolds_)
     for (int k = 0; k < m.point_count; ++k)
       if (m.points[k].kind == ContactKind::collision) m.points[k].normal_impulse = m.points[k].tangent_impulse = 0.0;
+}
+
+void NativeEngine::solve_contacts() {
+  if (!settings_.warm_start) {
+    last_sweeps_ = solve_velocities(manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
+    return;
+  }
+  // Warm starting applies last step's impulses before the sweeps. When the sweep limit stops
+  // the solve short of convergence (long pressed chains), what remains of them can raise the
+  // kinetic energy. Gauss-Seidel from zero impulses cannot: with a non-positive target each
+  // local update moves the velocity to the constraint set along M^-1 J^T, which never raises
+  // 1/2 v'Mv (a projection in the metric of M). So a step whose contact impulses would add
+  // kinetic energy is solved again from zero.
+  saved_velocity_ = bodies_.velocity;
+  saved_angular_velocity_ = bodies_.angular_velocity;
+  const double before = contact_kinetic_energy();
+  warm_start(manifolds_, bodies_);
+  last_sweeps_ = solve_velocities(manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
+  if (contact_kinetic_energy() <= before) return;
+  bodies_.velocity = saved_velocity_;
+  bodies_.angular_velocity = saved_angular_velocity_;
+  for (Manifold& m : manifolds_)
+    for (int k = 0; k < m.point_count; ++k) m.points[k].normal_impulse = m.points[k].tangent_impulse = 0.0;
+  last_sweeps_ += solve_velocities(manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
+  ++cold_restarts_;
+}
+
+double NativeEngine::contact_kinetic_energy() const {
+  // Twice the kinetic energy of the moving bodies: enough to compare before and after.
+  double e = 0.0;
+  const std::size_t nb = bodies_.position.size();
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (bodies_.inv_mass[i] == 0.0) continue;
+    e += length_squared(bodies_.velocity[i]) / bodies_.inv_mass[i] +
+         bodies_.angular_velocity[i] * bodies_.angular_velocity[i] / bodies_.inv_inertia[i];
+  }
+  return e;
 }
 
 void NativeEngine::apply_loads(const Loads& loads) {

@@ -1,0 +1,100 @@
+// The command line: exit codes, one-line errors, no output left behind on bad input.
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "support.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string output;
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(FLOEDEM_EXE) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+fs::path dir_for(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("floedem-cli-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("cli: a good run exits 0 and writes the output", "[cli]") {
+  const fs::path d = dir_for("good");
+  const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/head_on.toml";
+  const Result r = run("run " + scenario + " --out " + (d / "r.h5").string() + " --set run.duration=1");
+  CHECK(r.code == 0);
+  CHECK(r.output.find("impulses") != std::string::npos);
+  CHECK(fs::exists(d / "r.h5"));
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: bad input exits 2 with one line naming file and field, and leaves no file", "[cli]") {
+  const fs::path d = dir_for("bad");
+  const fs::path bad = d / "bad.toml";
+  std::ofstream(bad) << "[run]\nduration = 1.0\ndt = 0.01\n[contact]\nrestitution = 1.2\n"
+                        "[[body]]\npolygon = [[0,0],[1,0],[1,1]]\nthickness = 1\n";
+  const fs::path out = d / "r.h5";
+  Result r = run("run " + bad.string() + " --out " + out.string());
+  CHECK(r.code == 2);
+  CHECK(r.output.find(bad.string() + ":5") != std::string::npos);
+  CHECK(r.output.find("contact.restitution") != std::string::npos);
+  CHECK(r.output.find("[0, 1]") != std::string::npos);
+  CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);
+  CHECK_FALSE(fs::exists(out));
+  CHECK_FALSE(fs::exists(out.string() + ".partial"));
+
+  r = run("run " + (d / "missing.toml").string() + " --out " + out.string());
+  CHECK(r.code == 2);
+  CHECK(r.output.find("missing.toml") != std::string::npos);
+  CHECK_FALSE(fs::exists(out.string() + ".partial"));
+
+  const std::string good = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/head_on.toml";
+  r = run("run " + good + " --engine havok --out " + out.string());
+  CHECK(r.code == 2);
+  CHECK(r.output.find("unknown engine") != std::string::npos);
+  CHECK_FALSE(fs::exists(out.string() + ".partial"));
+
+  r = run("run " + good + " --set contact.friction=-1 --out " + out.string());
+  CHECK(r.code == 2);
+  CHECK(r.output.find("contact.friction") != std::string::npos);
+
+  r = run("run " + good + " --no-such-option");
+  CHECK(r.code == 2);
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: an unwritable output exits 3", "[cli]") {
+  const std::string good = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/head_on.toml";
+  const Result r = run("run " + good + " --out /nonexistent-dir/r.h5");
+  CHECK(r.code == 3);
+  CHECK(r.output.find("/nonexistent-dir/r.h5") != std::string::npos);
+}
+
+TEST_CASE("cli: help lists the commands and options", "[cli]") {
+  Result r = run("--help");
+  CHECK(r.code == 0);
+  CHECK(r.output.find("run") != std::string::npos);
+  r = run("run --help");
+  CHECK(r.code == 0);
+  for (const char* opt : {"--engine", "--out", "--set"}) CHECK(r.output.find(opt) != std::string::npos);
+}

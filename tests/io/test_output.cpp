@@ -1,0 +1,142 @@
+// The HDF5 layout of a run, the temporary name, and a killed run's readability.
+#include <catch2/catch.hpp>
+
+#include <H5Cpp.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "io/recorder.hpp"
+#include "run/simulation.hpp"
+#include "support.hpp"
+
+using namespace floedem;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<hsize_t> shape(const H5::DataSet& d) {
+  const H5::DataSpace s = d.getSpace();
+  std::vector<hsize_t> dims(static_cast<std::size_t>(s.getSimpleExtentNdims()));
+  s.getSimpleExtentDims(dims.data());
+  return dims;
+}
+
+std::string string_attribute(const H5::H5Object& o, const std::string& name) {
+  const H5::Attribute a = o.openAttribute(name);
+  std::string v;
+  a.read(a.getStrType(), v);
+  return v;
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("floedem-test-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+const std::string kScene = test::header_toml(1.0, 0.01, 0.3, 0.3, "[engine.native]\nvelocity_iterations = 20\n") +
+                           test::body_toml({"a", test::box({5, 5}, 10, 10), {1.0, 0.0}}) +
+                           test::body_toml({"b", {{10.5, 0}, {20.5, 0}, {10.5, 12}}, {}, 0.1});
+
+}  // namespace
+
+TEST_CASE("output layout: bodies, frames, contacts, attributes", "[output]") {
+  const fs::path dir = temp_dir("layout");
+  const std::string out = (dir / "r.h5").string();
+  Scene s = test::scene_from(kScene, {"run.output_every=10"});
+  RunOptions o;
+  o.output = out;
+  const RunSummary sum = run_scene(s, o);
+  CHECK(fs::exists(out));
+  CHECK_FALSE(fs::exists(out + ".partial"));
+  CHECK(sum.collision_impulses > 0);
+
+  H5::H5File f(out, H5F_ACC_RDONLY);
+  CHECK(string_attribute(f.openGroup("/"), "status") == "complete");
+  CHECK(string_attribute(f.openGroup("/"), "engine") == "native");
+  CHECK(string_attribute(f.openGroup("/"), "scenario") == kScene);
+  CHECK(string_attribute(f.openGroup("/"), "overrides") == "run.output_every=10");
+  CHECK_FALSE(string_attribute(f.openGroup("/"), "floedem_version").empty());
+  double dt = 0;
+  f.openAttribute("dt").read(H5::PredType::NATIVE_DOUBLE, &dt);
+  CHECK(dt == 0.01);
+
+  // 100 steps, every 10th, plus t = 0: 11 frames.
+  CHECK(shape(f.openDataSet("/time")) == std::vector<hsize_t>{11});
+  CHECK(shape(f.openDataSet("/bodies/position")) == std::vector<hsize_t>{11, 2, 2});
+  CHECK(shape(f.openDataSet("/bodies/angle")) == std::vector<hsize_t>{11, 2});
+  CHECK(shape(f.openDataSet("/bodies/velocity")) == std::vector<hsize_t>{11, 2, 2});
+  CHECK(shape(f.openDataSet("/bodies/angular_velocity")) == std::vector<hsize_t>{11, 2});
+  CHECK(shape(f.openDataSet("/bodies/name")) == std::vector<hsize_t>{2});
+  CHECK(shape(f.openDataSet("/bodies/polygon_vertices")) == std::vector<hsize_t>{7, 2});
+  std::vector<std::int64_t> offsets(3);
+  f.openDataSet("/bodies/polygon_offsets").read(offsets.data(), H5::PredType::NATIVE_INT64);
+  CHECK(offsets == std::vector<std::int64_t>{0, 4, 7});
+  std::vector<double> mass(2);
+  f.openDataSet("/bodies/mass").read(mass.data(), H5::PredType::NATIVE_DOUBLE);
+  CHECK(mass[0] == Approx(90000.0));
+  // Vertices are body-local: the centroid of each polygon is the origin.
+  std::vector<double> v(14);
+  f.openDataSet("/bodies/polygon_vertices").read(v.data(), H5::PredType::NATIVE_DOUBLE);
+  CHECK(v[0] == Approx(-5.0));
+  CHECK(v[1] == Approx(-5.0));
+
+  std::vector<double> time(11);
+  f.openDataSet("/time").read(time.data(), H5::PredType::NATIVE_DOUBLE);
+  CHECK(time[0] == 0.0);
+  CHECK(time[10] == Approx(1.0));
+  const hsize_t rows = shape(f.openDataSet("/contacts/time"))[0];
+  CHECK(rows == static_cast<hsize_t>(sum.contact_rows));
+  for (const char* name : {"body_a", "body_b", "normal_impulse", "tangent_impulse", "kind", "approach_velocity", "separation"})
+    CHECK(shape(f.openDataSet(std::string("/contacts/") + name)) == std::vector<hsize_t>{rows});
+  CHECK(shape(f.openDataSet("/contacts/point")) == std::vector<hsize_t>{rows, 2});
+  CHECK(shape(f.openDataSet("/contacts/normal")) == std::vector<hsize_t>{rows, 2});
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a run killed mid-way leaves a readable .partial and no final file", "[output]") {
+  const fs::path dir = temp_dir("killed");
+  const fs::path scenario = dir / "long.toml";
+  std::ofstream(scenario) << test::header_toml(1e7, 0.01, 0.3, 0.3) +
+                                 test::body_toml({"a", test::box({5, 5}, 10, 10), {1.0, 0.0}}) +
+                                 test::body_toml({"w", test::box({20, 5}, 2, 20), {}, 0.0, true});
+  const fs::path out = dir / "r.h5";
+  const std::string cmd = std::string("timeout -s KILL 3 ") + FLOEDEM_EXE + " run " + scenario.string() +
+                          " --quiet --set run.output_every=100 --out " + out.string() + " > /dev/null 2>&1";
+  const int rc = std::system(cmd.c_str());
+  CHECK(rc != 0);
+  CHECK_FALSE(fs::exists(out));
+  REQUIRE(fs::exists(out.string() + ".partial"));
+  // A killed process can outlive `timeout` for a moment as a zombie that still holds the
+  // file's lock: wait for it (up to 10 s) as a user would.
+  H5::H5File f;
+  for (int attempt = 0;; ++attempt) {
+    try {
+      f.openFile(out.string() + ".partial", H5F_ACC_RDONLY);
+      break;
+    } catch (const H5::Exception&) {
+      REQUIRE(attempt < 100);
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+  CHECK(string_attribute(f.openGroup("/"), "status") == "running");
+  const hsize_t frames = shape(f.openDataSet("/time"))[0];
+  CHECK(frames > 10);  // flushed at least once a second for ~2 s
+  std::vector<double> t(frames);
+  f.openDataSet("/time").read(t.data(), H5::PredType::NATIVE_DOUBLE);
+  CHECK(t[frames - 1] == Approx(1.0 * static_cast<double>(frames - 1)));  // every 100th step of 0.01 s
+  CHECK(shape(f.openDataSet("/bodies/position"))[0] == frames);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("an unwritable output directory is an output error, and nothing is left", "[output]") {
+  const Scene s = test::scene_from(kScene);
+  RunOptions o;
+  o.output = "/nonexistent-dir/r.h5";
+  CHECK_THROWS_AS(run_scene(s, o), OutputError);
+  CHECK_FALSE(fs::exists("/nonexistent-dir/r.h5.partial"));
+}

@@ -1,0 +1,76 @@
+#pragma once
+// Helpers shared by the tests: scenes from TOML text, engines, polygons as TOML.
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "engine/registry.hpp"
+#include "forcing/force_term.hpp"
+#include "scenario/scenario.hpp"
+
+namespace floedem::test {
+
+inline Scene scene_from(const std::string& toml, const std::vector<std::string>& overrides = {}) {
+  return parse_scenario(toml, "test.toml", overrides);
+}
+
+inline std::unique_ptr<Engine> native(const Scene& s) { return make_engine("native", s); }
+
+/// TOML array of the vertices, e.g. "[[0, 0], [1, 0], [1, 1]]", written exactly (17 digits).
+inline std::string toml_polygon(const std::vector<Vec2>& pts) {
+  std::ostringstream o;
+  o.precision(17);
+  o << "[";
+  for (std::size_t i = 0; i < pts.size(); ++i) o << (i ? ", " : "") << "[" << pts[i].x << ", " << pts[i].y << "]";
+  o << "]";
+  return o.str();
+}
+
+/// Rectangle w x h centred at c, turned by angle q.
+inline std::vector<Vec2> box(Vec2 c, double w, double h, double q = 0.0) {
+  const Rot r = Rot::from_angle(q);
+  std::vector<Vec2> out;
+  for (const Vec2 p : {Vec2{-w / 2, -h / 2}, Vec2{w / 2, -h / 2}, Vec2{w / 2, h / 2}, Vec2{-w / 2, h / 2}})
+    out.push_back(c + r.apply(p));
+  return out;
+}
+
+inline std::string vec_toml(Vec2 v) {
+  std::ostringstream o;
+  o.precision(17);
+  o << "[" << v.x << ", " << v.y << "]";
+  return o.str();
+}
+
+struct BodyText {
+  std::string name;
+  std::vector<Vec2> polygon;
+  Vec2 velocity{};
+  double angular_velocity = 0.0;
+  bool fixed = false;
+  Vec2 force{};
+  double thickness = 1.0;
+  double density = 900.0;
+};
+
+inline std::string body_toml(const BodyText& b) {
+  std::ostringstream o;
+  o.precision(17);
+  o << "[[body]]\nname = \"" << b.name << "\"\npolygon = " << toml_polygon(b.polygon) << "\nthickness = " << b.thickness
+    << "\ndensity = " << b.density << "\nvelocity = " << vec_toml(b.velocity)
+    << "\nangular_velocity = " << b.angular_velocity << "\nfixed = " << (b.fixed ? "true" : "false")
+    << "\napplied_force = " << vec_toml(b.force) << "\n";
+  return o.str();
+}
+
+inline std::string header_toml(double duration, double dt, double e, double mu, const std::string& extra = "") {
+  std::ostringstream o;
+  o.precision(17);
+  o << "[run]\nduration = " << duration << "\ndt = " << dt << "\n[contact]\nrestitution = " << e << "\nfriction = " << mu
+    << "\n" << extra << "\n";
+  return o.str();
+}
+
+}  // namespace floedem::test
