@@ -29,11 +29,20 @@ struct BodyStates {
   }
 };
 
+/// A body moved on a prescribed velocity over the step (towing at constant speed): the engine
+/// treats it as kinematic (infinite mass in contacts) and moves it by dt times this velocity.
+struct PrescribedMotion {
+  std::int32_t body = 0;
+  Vec2 velocity;
+  double angular_velocity = 0.0;
+};
+
 /// Non-contact loads on each body, constant over one step (N at the centroid, N m).
 struct Loads {
   std::vector<Vec2> force;
   std::vector<double> torque;
-  bool any = false;  ///< false: every entry is zero and the engine may skip them
+  bool any = false;  ///< false: every force entry is zero and the engine may skip them
+  std::vector<PrescribedMotion> prescribed;
 };
 
 enum class ContactKind : std::uint8_t {

@@ -17,11 +17,8 @@ class AppliedLoad final : public ForceTerm {
   }
   bool empty() const { return loaded_.empty(); }
   std::string_view name() const override { return "applied_load"; }
-  void add(const BodyStates&, double, Loads& loads) const override {
-    for (const Entry& e : loaded_) {
-      loads.force[e.body] += e.force;
-      loads.torque[e.body] += e.torque;
-    }
+  void add(const BodyStates&, double, ForceSums& sums) const override {
+    for (const Entry& e : loaded_) sums.add_force(e.body, e.force, e.torque);
   }
 
  private:

@@ -1,8 +1,12 @@
 #pragma once
-// Non-contact forcing as small independent units. Each term adds its force and torque to the
-// loads of the step; a term a scene does not use is never built, so it costs nothing.
-// The same terms drive every engine, so that engines differ only in contact.
-// Adding a term: one source file with a builder, and one line in forcing.cpp's table.
+// Non-contact forcing as small independent units (MODEL.md section 2). Each term adds, per
+// body, its generalised force Q = (F_x, F_y, torque) at the start of the step and, where it
+// depends on the body's velocity, the Jacobian dQ/dq with q = (v_x, v_y, omega); Coriolis adds
+// a rotation rate instead. Forcing (forcing.cpp) then takes one linearly implicit step per body
+// and hands the engines the equivalent constant loads. A term a scene does not use is never
+// built, so it costs nothing. The same terms drive every engine, so that engines differ only
+// in contact. Adding a term: one source file with a builder, and one line in forcing.cpp.
+#include <array>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -12,12 +16,30 @@
 
 namespace floedem {
 
+/// Per-body sums the terms add to, in world axes about each body's centroid.
+struct ForceSums {
+  std::vector<std::array<double, 3>> q;   ///< generalised force (N, N, N m)
+  std::vector<std::array<double, 9>> dq;  ///< dQ/dq, row-major 3x3
+  std::vector<double> rotation_rate;      ///< f of -m f k x v (1/s); treated exactly, see forcing.cpp
+  bool any_jacobian = false;
+  bool any_rotation = false;
+
+  void add_force(std::size_t i, Vec2 f, double torque) {
+    q[i][0] += f.x;
+    q[i][1] += f.y;
+    q[i][2] += torque;
+  }
+  /// Adds the force f acting at offset r (world) from the centroid, with dF/du = a (2x2,
+  /// row-major) where u = flow - (v + w k x r): Q += G^T f, dQ/dq -= G^T a G, G = [I, k x r].
+  void add_point_force(std::size_t i, Vec2 r, Vec2 f, const std::array<double, 4>& a, bool with_torque);
+};
+
 class ForceTerm {
  public:
   virtual ~ForceTerm() = default;
   virtual std::string_view name() const = 0;
-  /// Adds this term's force and torque on each body at the start of a step at `time`.
-  virtual void add(const BodyStates& state, double time, Loads& loads) const = 0;
+  /// Adds this term at the start of a step at `time`.
+  virtual void add(const BodyStates& state, double time, ForceSums& sums) const = 0;
 };
 
 /// Builds the term for a scene, or returns nullptr when the scene does not use it.
@@ -27,17 +49,31 @@ using ForceTermBuilder = std::unique_ptr<ForceTerm> (*)(const Scene&);
 class Forcing {
  public:
   explicit Forcing(const Scene& scene);
-  bool empty() const { return terms_.empty(); }
+  bool empty() const { return terms_.empty() && prescribed_.empty(); }
   std::vector<std::string_view> names() const;
-  /// Loads at the start of a step, or nullptr when the scene has no forcing at all.
+  /// Loads for the step that starts at `time`, or nullptr when the scene has no forcing.
   const Loads* evaluate(const BodyStates& state, double time);
+  /// The generalised force of all terms on body i at the start of the last evaluated step.
+  std::array<double, 3> environment_force(std::size_t i) const { return sums_.q[i]; }
 
  private:
   std::vector<std::unique_ptr<ForceTerm>> terms_;
+  std::vector<std::size_t> prescribed_;
+  const Scene& scene_;
+  double dt_;
+  ForceSums sums_;
   Loads loads_;
 };
 
-// Builders (one per term file).
+// Builders, one per term file.
 std::unique_ptr<ForceTerm> build_applied_load(const Scene& scene);
+std::unique_ptr<ForceTerm> build_water_form_drag(const Scene& scene);
+std::unique_ptr<ForceTerm> build_water_skin_drag(const Scene& scene);
+std::unique_ptr<ForceTerm> build_air_form_drag(const Scene& scene);
+std::unique_ptr<ForceTerm> build_air_skin_drag(const Scene& scene);
+std::unique_ptr<ForceTerm> build_coriolis(const Scene& scene);
+std::unique_ptr<ForceTerm> build_sea_surface_tilt(const Scene& scene);
+std::unique_ptr<ForceTerm> build_wave_radiation(const Scene& scene);
+std::unique_ptr<ForceTerm> build_rope_tow(const Scene& scene);
 
 }  // namespace floedem

@@ -117,6 +117,11 @@ struct Recorder::Impl {
   std::vector<std::int32_t> k_body_a, k_body_b;
   std::vector<std::uint8_t> k_kind;
   H5::EnumType kind_type = contact_kind_type();
+  ContactOutput contact_output = ContactOutput::all;
+  // Towing.
+  bool tow = false;
+  Series tow_force, tow_force_mean, tow_tug;
+  std::vector<double> w_force, w_mean, w_tug;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false;
 
@@ -128,6 +133,12 @@ struct Recorder::Impl {
       velocity.append(b_velocity.data(), buffered_frames);
       angular_velocity.append(b_angular_velocity.data(), buffered_frames);
       b_time.clear(); b_position.clear(); b_angle.clear(); b_velocity.clear(); b_angular_velocity.clear();
+      if (tow) {
+        tow_force.append(w_force.data(), buffered_frames);
+        tow_force_mean.append(w_mean.data(), buffered_frames);
+        tow_tug.append(w_tug.data(), buffered_frames);
+        w_force.clear(); w_mean.clear(); w_tug.clear();
+      }
       buffered_frames = 0;
     }
     const hsize_t rows = k_time.size();
@@ -242,6 +253,17 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     d.c_approach = Series(contacts, "approach_velocity", H5::PredType::NATIVE_DOUBLE, {}, kc);
     d.c_separation = Series(contacts, "separation", H5::PredType::NATIVE_DOUBLE, {}, kc);
     d.c_kind = Series(contacts, "kind", d.kind_type, {}, kc);
+    d.contact_output = scene.output.contacts;
+
+    if (scene.tow.mode != TowSpec::Mode::none) {
+      d.tow = true;
+      H5::Group tow = d.file.createGroup("/tow");
+      write_attribute(tow, "mode", scene.tow.mode == TowSpec::Mode::velocity ? "velocity" : "rope");
+      write_attribute(tow, "body", scene.bodies[scene.tow.body].name);
+      d.tow_force = Series(tow, "force", H5::PredType::NATIVE_DOUBLE, {2}, d.frame_chunk);
+      d.tow_force_mean = Series(tow, "force_mean", H5::PredType::NATIVE_DOUBLE, {2}, d.frame_chunk);
+      d.tow_tug = Series(tow, "tug_position", H5::PredType::NATIVE_DOUBLE, {2}, d.frame_chunk);
+    }
     d.flush();
   } catch (const H5::Exception& e) {
     std::error_code ec;
@@ -284,7 +306,9 @@ void Recorder::write_frame(double time, const BodyStates& state) {
 
 void Recorder::write_contacts(double time, std::span<const ContactRecord> contacts) {
   Impl& d = *impl_;
+  if (d.contact_output == ContactOutput::none) return;
   for (const ContactRecord& c : contacts) {
+    if (d.contact_output == ContactOutput::collisions && c.kind != ContactKind::collision) continue;
     d.k_time.push_back(time);
     d.k_body_a.push_back(c.body_a);
     d.k_body_b.push_back(c.body_b);
@@ -303,6 +327,14 @@ void Recorder::write_contacts(double time, std::span<const ContactRecord> contac
   } catch (const H5::Exception& e) {
     throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full?");
   }
+}
+
+void Recorder::write_tow(Vec2 force, Vec2 mean_force, Vec2 tug_position) {
+  Impl& d = *impl_;
+  // Called before write_frame for the same frame: the rows line up with /time.
+  d.w_force.insert(d.w_force.end(), {force.x, force.y});
+  d.w_mean.insert(d.w_mean.end(), {mean_force.x, mean_force.y});
+  d.w_tug.insert(d.w_tug.end(), {tug_position.x, tug_position.y});
 }
 
 std::int64_t Recorder::frames() const {

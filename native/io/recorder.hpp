@@ -33,7 +33,10 @@ class Recorder {
   Recorder& operator=(const Recorder&) = delete;
 
   void write_frame(double time, const BodyStates& state);
+  /// Contact rows (all, collisions only, or none, as the scene's [output] says).
   void write_contacts(double time, std::span<const ContactRecord> contacts);
+  /// /tow at a frame: force of the last step, mean force since the last frame, tug position.
+  void write_tow(Vec2 force, Vec2 mean_force, Vec2 tug_position);
   /// Writes what is buffered, marks the file complete, closes it and renames it to `path`.
   void finish(const std::vector<std::pair<std::string, double>>& summary);
 

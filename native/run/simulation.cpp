@@ -5,11 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "engine/registry.hpp"
 #include "forcing/force_term.hpp"
 #include "io/recorder.hpp"
+#include "towing/tow.hpp"
 #include "version.hpp"
 
 namespace floedem {
@@ -79,12 +81,16 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const std::int64_t steps = scene.run.steps();
   const double dt = scene.run.dt;
   summary.kinetic_energy_start = kinetic_energy(scene, engine->state());
+  TowMonitor tow(scene);
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  if (tow.active()) recorder.write_tow({nan, nan}, {nan, nan}, tow.tug_position(0.0));  // no step yet
   recorder.write_frame(0.0, engine->state());
   Progress progress(options.progress);
   for (std::int64_t k = 1; k <= steps; ++k) {
     // Time as k * dt rather than a running sum: no drift over long runs.
     const double t_start = static_cast<double>(k - 1) * dt;
     const double t_end = static_cast<double>(k) * dt;
+    if (tow.active()) tow.before_step(engine->state(), t_start);
     engine->step(forcing.evaluate(engine->state(), t_start));
     const BodyStates& state = engine->state();
     if (!finite_state(state))
@@ -94,7 +100,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     for (const ContactRecord& c : contacts)
       ++(c.kind == ContactKind::collision ? summary.collision_impulses : summary.resting_impulses);
     recorder.write_contacts(t_end, contacts);
-    if (k % scene.run.output_every == 0 || k == steps) recorder.write_frame(t_end, state);
+    if (tow.active()) tow.after_step(contacts, forcing.environment_force(scene.tow.body));
+    if (k % scene.run.output_every == 0 || k == steps) {
+      if (tow.active()) recorder.write_tow(tow.force(), tow.take_mean(), tow.tug_position(t_end));
+      recorder.write_frame(t_end, state);
+    }
     progress.update(k, steps);
   }
   progress.done();

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "geometry/polygon.hpp"
+#include <cmath>
 #include "scenario/table_reader.hpp"
 #include "scene/input_error.hpp"
 #include "scene/overlap.hpp"
@@ -149,7 +150,165 @@ void check_polygon(TableReader& r, BodySpec& b) {
   }
 }
 
-void read_bodies(TableReader& root, Scene& scene) {
+void read_drag(TableReader& r, DragCoefficients& d) {
+  d.water_form = r.real("water_form", d.water_form, Range::non_negative());
+  d.water_skin = r.real("water_skin", d.water_skin, Range::non_negative());
+  d.air_form = r.real("air_form", d.air_form, Range::non_negative());
+  d.air_skin = r.real("air_skin", d.air_skin, Range::non_negative());
+  d.wave_radiation = r.real("wave_radiation", d.wave_radiation, Range::non_negative());
+}
+
+struct EnvironmentDefaults {
+  double ice_density = 900.0;
+  DragCoefficients floe, iceberg;
+};
+
+EnvironmentDefaults read_environment(TableReader& root, Scene& scene) {
+  EnvironmentDefaults defaults;
+  const toml::table* t = root.table("environment");
+  if (!t) return defaults;
+  scene.has_environment = true;
+  EnvironmentSpec& env = scene.environment;
+  TableReader r(*t, scene.source_path, "environment");
+  if (r.has("current_profile") && r.has("current")) r.fail("current_profile", "give current or current_profile, not both");
+  env.current = r.vec2("current", Vec2{});
+  if (r.has("current_profile")) {
+    const auto rows = r.rows("current_profile", 3);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      if (k == 0 && rows[k][0] != 0.0) r.fail("current_profile", "the first layer must start at depth 0; allowed [[0, u, v], ...]");
+      if (k > 0 && !(rows[k][0] > rows[k - 1][0]))
+        r.fail("current_profile", "depths must increase (row " + std::to_string(k) + ")");
+      env.current_profile.push_back({rows[k][0], {rows[k][1], rows[k][2]}});
+    }
+    env.current = env.current_profile.front().velocity;
+  }
+  env.wind = r.vec2("wind", Vec2{});
+  env.water_density = r.real("water_density", env.water_density, Range::positive());
+  env.air_density = r.real("air_density", env.air_density, Range::non_negative());
+  env.gravity = r.real("gravity", env.gravity, Range::non_negative());
+  defaults.ice_density = r.real("ice_density", defaults.ice_density, Range::positive());
+  if (r.has("latitude")) {
+    const double degrees = r.real("latitude", 0.0, Range::closed(-90.0, 90.0));
+    constexpr double kEarthRotation = 7.2921e-5;  // rad/s, sidereal (MODEL.md 2)
+    env.coriolis = true;
+    env.latitude = degrees * M_PI / 180.0;
+    env.coriolis_parameter = 2.0 * kEarthRotation * std::sin(env.latitude);
+  }
+  const bool current_flows = env.current != Vec2{} || !env.current_profile.empty();
+  env.sea_surface_tilt = r.boolean("sea_surface_tilt", env.coriolis && current_flows);
+  if (env.sea_surface_tilt && !env.coriolis)
+    r.fail("sea_surface_tilt", "needs a latitude (the tilt balances the Coriolis force of the current)");
+  env.rotational_damping = r.boolean("rotational_damping", env.rotational_damping);
+  env.drag_reference_speed = r.real("drag_reference_speed", 0.0, Range::non_negative());
+  env.added_mass_in_contacts = r.boolean("added_mass_in_contacts", env.added_mass_in_contacts);
+  if (const toml::table* w = r.table("waves")) {
+    TableReader wr(*w, scene.source_path, "environment.waves");
+    env.waves.present = true;
+    env.waves.amplitude = wr.real("amplitude", std::nullopt, Range::non_negative());
+    if (wr.has("period") && wr.has("wavelength")) wr.fail("wavelength", "give period or wavelength, not both");
+    env.waves.period = wr.real("period", 0.0, Range::non_negative());
+    env.waves.wavelength = wr.real("wavelength", 0.0, Range::non_negative());
+    if (env.waves.period > 0.0)  // deep water: L = g T^2 / (2 pi)
+      env.waves.wavelength = env.gravity * env.waves.period * env.waves.period / (2.0 * M_PI);
+    else if (env.waves.wavelength > 0.0)
+      env.waves.period = std::sqrt(2.0 * M_PI * env.waves.wavelength / env.gravity);
+    env.waves.direction = wr.real("direction", 0.0, Range::closed(-360.0, 360.0)) * M_PI / 180.0;
+    wr.reject_unknown();
+  }
+  if (const toml::table* d = r.table("drag")) {
+    TableReader dr(*d, scene.source_path, "environment.drag");
+    DragCoefficients common;
+    read_drag(dr, common);
+    defaults.floe = defaults.iceberg = common;
+    if (const toml::table* f = dr.table("floe")) {
+      TableReader fr(*f, scene.source_path, "environment.drag.floe");
+      read_drag(fr, defaults.floe);
+      fr.reject_unknown();
+    }
+    if (const toml::table* i = dr.table("iceberg")) {
+      TableReader ir(*i, scene.source_path, "environment.drag.iceberg");
+      read_drag(ir, defaults.iceberg);
+      ir.reject_unknown();
+    }
+    dr.reject_unknown();
+  }
+  r.reject_unknown();
+  return defaults;
+}
+
+std::vector<std::pair<double, Vec2>> read_path(TableReader& r, const char* constant_key, const char* path_key) {
+  if (r.has(constant_key) && r.has(path_key)) r.fail(path_key, std::string("give ") + constant_key + " or " + path_key + ", not both");
+  if (!r.has(path_key)) return {{0.0, r.vec2(constant_key, std::nullopt)}};
+  const auto rows = r.rows(path_key, 3);
+  std::vector<std::pair<double, Vec2>> path;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (rows[k][0] < 0.0) r.fail(path_key, "times must be >= 0 s (row " + std::to_string(k) + ")");
+    if (k > 0 && !(rows[k][0] > rows[k - 1][0])) r.fail(path_key, "times must increase (row " + std::to_string(k) + ")");
+    path.push_back({rows[k][0], {rows[k][1], rows[k][2]}});
+  }
+  return path;
+}
+
+void read_tow(TableReader& root, Scene& scene) {
+  const toml::table* t = root.table("tow");
+  if (!t) return;
+  TableReader r(*t, scene.source_path, "tow");
+  TowSpec& tow = scene.tow;
+  const std::string mode = r.string("mode", std::nullopt, {"velocity", "rope"});
+  const std::string name = r.string("body", std::nullopt);
+  bool found = false;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+    if (scene.bodies[i].name == name) {
+      tow.body = i;
+      found = true;
+    }
+  if (!found) r.fail("body", "no body is named \"" + name + "\"");
+  BodySpec& b = scene.bodies[tow.body];
+  if (b.fixed) r.fail("body", "\"" + name + "\" is fixed and cannot be towed");
+  if (mode == "velocity") {
+    tow.mode = TowSpec::Mode::velocity;
+    tow.path = read_path(r, "velocity", "path");
+    b.prescribed = true;
+    b.velocity = tow.velocity_at(0.0);  // the towed body starts on its path, heading held
+    b.angular_velocity = 0.0;
+  } else {
+    tow.mode = TowSpec::Mode::rope;
+    tow.path = read_path(r, "tug_velocity", "tug_path");
+    tow.stiffness = r.real("stiffness", std::nullopt, Range::positive());
+    tow.length = r.real("length", std::nullopt, Range::positive());
+    tow.damping = r.real("damping", 0.0, Range::non_negative());
+    tow.attachment = r.vec2("attachment", Vec2{});
+    // Default tug start: the rope's length ahead of the attachment, along the tug's first velocity.
+    const Vec2 heading = length(tow.path.front().second) > 0.0 ? normalized(tow.path.front().second) : Vec2{1.0, 0.0};
+    const AreaMoments m = area_moments(b.polygon);
+    tow.tug_start = r.vec2("tug_start", m.centroid + tow.attachment + tow.length * heading);
+  }
+  r.reject_unknown();
+}
+
+std::vector<KeelLayer> read_keel(TableReader& r, double draft) {
+  if (!r.has("keel_layers")) return {KeelLayer{0.0, draft, 1.0}};
+  const auto pairs = r.rows("keel_layers", 2);  // [thickness, width_scale] rows
+  std::vector<Vec2> rows;
+  for (const auto& p : pairs) rows.push_back({p[0], p[1]});
+  std::vector<KeelLayer> keel;
+  double depth = 0.0;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (!(rows[k].x > 0.0)) r.fail("keel_layers", "layer " + std::to_string(k) + " thickness must be > 0 m");
+    if (!(rows[k].y > 0.0 && rows[k].y <= 10.0))
+      r.fail("keel_layers", "layer " + std::to_string(k) + " width_scale must be in (0, 10]");
+    keel.push_back({depth, depth + rows[k].x, rows[k].y});
+    depth += rows[k].x;
+  }
+  if (keel.empty() || std::abs(depth - draft) > 1e-6 * draft)
+    r.fail("keel_layers", "layer thicknesses add up to " + std::to_string(depth) + " m; they must add up to the draft, " +
+                              std::to_string(draft) + " m");
+  keel.back().bottom = draft;
+  return keel;
+}
+
+void read_bodies(TableReader& root, Scene& scene, double ice_density, const DragCoefficients& drag_floe,
+                 const DragCoefficients& drag_iceberg) {
   const auto tables = root.array_of_tables("body");
   std::set<std::string> names;
   for (std::size_t i = 0; i < tables.size(); ++i) {
@@ -160,8 +319,31 @@ void read_bodies(TableReader& root, Scene& scene) {
     if (!names.insert(b.name).second) r.fail("name", "\"" + b.name + "\" is used by an earlier body; names must be unique");
     b.polygon = r.points("polygon");
     check_polygon(r, b);
-    b.thickness = r.real("thickness", std::nullopt, Range::positive());
-    b.density = r.real("density", b.density, Range::positive());
+    const std::string kind = r.string("kind", "floe", {"floe", "iceberg"});
+    b.kind = kind == "iceberg" ? BodyKind::iceberg : BodyKind::floe;
+    b.density = r.real("density", ice_density, Range::positive());
+    if (b.kind == BodyKind::floe) {
+      b.thickness = r.real("thickness", std::nullopt, Range::positive());
+      for (const char* k : {"draft", "sail_height", "keel_layers", "mass", "shape_factor"})
+        if (r.has(k)) r.fail(k, "is for kind = \"iceberg\" only; a floe has a thickness");
+      b.added_mass_coefficient = r.real("added_mass_coefficient", 0.0, Range::closed(0.0, 10.0));
+      b.drag = drag_floe;
+    } else {
+      if (r.has("thickness")) r.fail("thickness", "an iceberg is given by draft and sail_height, not thickness");
+      b.draft = r.real("draft", std::nullopt, Range::positive());
+      b.freeboard = r.real("sail_height", std::nullopt, Range::non_negative());
+      b.thickness = b.draft + b.freeboard;
+      b.given_mass = r.real("mass", 0.0, Range::non_negative());
+      b.shape_factor = r.real("shape_factor", 1.0, Range{0.0, 1.0, true, false});
+      b.added_mass_coefficient = r.real("added_mass_coefficient", 0.5, Range::closed(0.0, 10.0));
+      b.keel = read_keel(r, b.draft);
+      b.drag = drag_iceberg;
+    }
+    if (const toml::table* d = r.table("drag")) {
+      TableReader dr(*d, scene.source_path, r.field_name("drag"));
+      read_drag(dr, b.drag);
+      dr.reject_unknown();
+    }
     b.velocity = r.vec2("velocity", Vec2{});
     b.angular_velocity = r.real("angular_velocity", 0.0, Range::any());
     b.fixed = r.boolean("fixed", false);
@@ -206,7 +388,9 @@ Scene parse_scenario(const std::string& text, const std::string& path, const std
   read_run(root, scene);
   read_contact(root, scene);
   read_output(root, scene);
-  read_bodies(root, scene);
+  const EnvironmentDefaults defaults = read_environment(root, scene);
+  read_bodies(root, scene, defaults.ice_density, defaults.floe, defaults.iceberg);
+  read_tow(root, scene);
   read_engines(root, scene);
   root.reject_unknown();
 

@@ -175,6 +175,28 @@ std::vector<Vec2> TableReader::points(std::string_view key) {
   return out;
 }
 
+std::vector<std::vector<double>> TableReader::rows(std::string_view key, std::size_t width) {
+  const std::string shape = "an array of rows of " + std::to_string(width) + " numbers";
+  const toml::node* n = lookup(key);
+  if (!n) fail(key, "missing (required), allowed " + shape);
+  const toml::array* a = n->as_array();
+  if (!a || a->empty()) fail(key, "expected " + shape);
+  std::vector<std::vector<double>> out;
+  for (std::size_t k = 0; k < a->size(); ++k) {
+    const toml::array* row = a->get(k)->as_array();
+    const std::string which = "row " + std::to_string(k);
+    if (!row || row->size() != width) fail(key, which + " must have " + std::to_string(width) + " numbers; allowed " + shape);
+    std::vector<double> r;
+    for (std::size_t i = 0; i < width; ++i) {
+      const auto c = as_real(*row->get(i));
+      if (!c || !std::isfinite(*c)) fail(key, which + " entry " + std::to_string(i) + " must be a finite number");
+      r.push_back(*c);
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
 const toml::table* TableReader::table(std::string_view key) {
   const toml::node* n = lookup(key);
   if (!n) return nullptr;

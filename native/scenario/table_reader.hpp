@@ -47,6 +47,8 @@ class TableReader {
   Vec2 vec2(std::string_view key, std::optional<Vec2> fallback);
   /// An array of [x, y] points (no further checks here).
   std::vector<Vec2> points(std::string_view key);
+  /// An array of rows of `width` finite numbers each (at least one row).
+  std::vector<std::vector<double>> rows(std::string_view key, std::size_t width);
   /// A sub-table, or nullptr when absent; an error when present with another type.
   const toml::table* table(std::string_view key);
   /// An array of tables ([[key]]), empty when absent.

@@ -35,15 +35,78 @@ void Scene::derive() {
     const AreaMoments m = area_moments(b.polygon);
     b.area = m.area;
     b.centroid = m.centroid;
-    b.mass = b.density * b.thickness * m.area;
-    b.inertia = b.density * b.thickness * m.polar_moment;
+    if (b.kind == BodyKind::floe) {
+      // Floating floe (MODEL.md 2): draft = h rho_i / rho_w, freeboard = h - draft.
+      b.mass = b.density * b.thickness * m.area;
+      b.draft = b.thickness * b.density / environment.water_density;
+      b.freeboard = b.thickness - b.draft;
+      b.keel = {KeelLayer{0.0, b.draft, 1.0}};
+    } else {
+      // Iceberg (MODEL.md 1): mass given, or rho_i A (draft + sail) times a shape factor.
+      b.mass = b.given_mass > 0.0 ? b.given_mass : b.density * m.area * b.thickness * b.shape_factor;
+    }
+    // Polar moment of a uniform prism: I = m J / A, J the polygon's polar moment of area.
+    b.inertia = b.mass * m.polar_moment / m.area;
     b.local_polygon.clear();
     for (const Vec2 p : b.polygon) b.local_polygon.push_back(p - m.centroid);
-    b.local_parts = convex_partition(b.local_polygon);
+    b.local_parts = convex_partition(remove_collinear(b.local_polygon));
     if (b.local_parts.empty())
       throw InputError(input_message(source_path, 0, "body '" + b.name + "'.polygon",
                                      "could not be split into convex parts"));
   }
+}
+
+}  // namespace floedem
+
+namespace floedem {
+
+double Scene::engine_mass(std::size_t i) const {
+  const BodySpec& b = bodies[i];
+  return b.mass * (environment.added_mass_in_contacts ? 1.0 + b.added_mass_coefficient : 1.0);
+}
+
+double Scene::engine_inertia(std::size_t i) const {
+  const BodySpec& b = bodies[i];
+  return b.inertia * (environment.added_mass_in_contacts ? 1.0 + b.added_mass_coefficient : 1.0);
+}
+
+Vec2 EnvironmentSpec::current_at(double depth) const {
+  if (current_profile.empty()) return current;
+  Vec2 v = current_profile.front().velocity;
+  for (const CurrentLayer& l : current_profile)
+    if (depth >= l.depth) v = l.velocity;
+  return v;
+}
+
+Vec2 TowSpec::velocity_at(double t) const {
+  if (path.empty()) return {};
+  if (t <= path.front().first) return path.front().second;
+  for (std::size_t k = 1; k < path.size(); ++k) {
+    if (t <= path[k].first) {
+      const double w = (t - path[k - 1].first) / (path[k].first - path[k - 1].first);
+      return (1.0 - w) * path[k - 1].second + w * path[k].second;
+    }
+  }
+  return path.back().second;
+}
+
+Vec2 TowSpec::acceleration_at(double t) const {
+  for (std::size_t k = 1; k < path.size(); ++k)
+    if (t >= path[k - 1].first && t < path[k].first)
+      return (1.0 / (path[k].first - path[k - 1].first)) * (path[k].second - path[k - 1].second);
+  return {};
+}
+
+Vec2 TowSpec::displacement(double t0, double t1) const {
+  // Exact for a piecewise-linear velocity: trapezoids between the path's corners.
+  std::vector<double> cuts{t0};
+  for (const auto& [t, v] : path)
+    if (t > t0 && t < t1) cuts.push_back(t);
+  cuts.push_back(t1);
+  Vec2 d;
+  for (std::size_t k = 1; k < cuts.size(); ++k)
+    d += (0.5 * (cuts[k] - cuts[k - 1])) * (velocity_at(cuts[k - 1]) + velocity_at(cuts[k]));
+  return d;
 }
 
 }  // namespace floedem

@@ -34,9 +34,28 @@ struct OutputSettings {
   ContactOutput contacts = ContactOutput::all;  ///< which contact impulses are recorded
 };
 
+/// Drag and radiation coefficients (MODEL.md section 2; Bigg et al. 1997 for icebergs).
+struct DragCoefficients {
+  double water_form = 0.9;      ///< C_w, keel form drag
+  double water_skin = 5e-4;     ///< C_dw, bottom skin drag
+  double air_form = 1.3;        ///< C_a, sail form drag
+  double air_skin = 2.5e-4;     ///< C_da, top skin drag
+  double wave_radiation = 0.3;  ///< C_r
+};
+
+enum class BodyKind : std::uint8_t { floe = 0, iceberg = 1 };
+
+/// A depth slab of a body below the waterline, with the current it sits in.
+struct KeelLayer {
+  double top = 0.0;          ///< m below the waterline
+  double bottom = 0.0;       ///< m below the waterline
+  double width_scale = 1.0;  ///< the waterline polygon scaled about the centroid by this
+};
+
 /// One rigid body as the scenario gives it, plus what is derived from it.
 struct BodySpec {
   std::string name;
+  BodyKind kind = BodyKind::floe;
   std::vector<Vec2> polygon;     ///< m, world coordinates at t = 0, counter-clockwise
   double thickness = 0.0;        ///< m
   double density = 900.0;        ///< kg/m^3
@@ -46,14 +65,77 @@ struct BodySpec {
   Vec2 applied_force;            ///< N, constant, at the centroid
   double applied_torque = 0.0;   ///< N m, constant
   bool reversed_input = false;   ///< the file gave the polygon clockwise; it was reversed
+  // Iceberg geometry (floes: draft = h rho_i / rho_w, freeboard = h - draft, one keel layer).
+  double draft = 0.0;            ///< m below the waterline (derived for floes)
+  double freeboard = 0.0;        ///< m above it: the sail height of an iceberg (derived for floes)
+  std::vector<KeelLayer> keel;   ///< slabs from 0 to draft
+  double given_mass = 0.0;       ///< kg, iceberg mass when the file gives it (0: computed)
+  double shape_factor = 1.0;     ///< iceberg mass = rho_i A (draft + sail) shape_factor
+  double added_mass_coefficient = 0.0;  ///< C_m: added mass m_a = C_m m (also on the moment)
+  DragCoefficients drag;         ///< in force for this body (kind defaults, then the body's own)
+  bool prescribed = false;       ///< moved on a prescribed velocity (towing, mode "velocity")
 
   // Derived at load time (Scene::derive): the same for every engine.
   Vec2 centroid;                               ///< m, world position at t = 0 (the reference point)
   double area = 0.0;                           ///< m^2
-  double mass = 0.0;                           ///< kg, density * area * thickness
+  double mass = 0.0;                           ///< kg, density * area * thickness (floe)
   double inertia = 0.0;                        ///< kg m^2, polar moment about the centroid
   std::vector<Vec2> local_polygon;             ///< relative to the centroid, angle 0
   std::vector<std::vector<Vec2>> local_parts;  ///< convex parts of local_polygon (one if convex)
+};
+
+/// A layer of the current: from `depth` (m below the surface) down to the next layer's depth.
+struct CurrentLayer {
+  double depth = 0.0;
+  Vec2 velocity;
+};
+
+struct WaveSpec {
+  bool present = false;
+  double amplitude = 0.0;   ///< m
+  double period = 0.0;      ///< s (0: not given)
+  double wavelength = 0.0;  ///< m (deep-water L = g T^2 / (2 pi) when only the period is given)
+  double direction = 0.0;   ///< rad, direction the waves travel to, counter-clockwise from +x
+};
+
+/// [environment]: the water, the air and the earth the bodies move in.
+struct EnvironmentSpec {
+  Vec2 current;                             ///< m/s, uniform (used when there is no profile)
+  std::vector<CurrentLayer> current_profile;///< by depth, first layer at depth 0
+  Vec2 wind;                                ///< m/s, at sail height
+  bool coriolis = false;                    ///< a latitude was given
+  double latitude = 0.0;                    ///< rad
+  double coriolis_parameter = 0.0;          ///< f = 2 Omega sin(latitude), 1/s
+  bool sea_surface_tilt = false;            ///< m f k x V_w (geostrophic current)
+  WaveSpec waves;
+  double water_density = 1025.0;            ///< kg/m^3
+  double air_density = 1.25;                ///< kg/m^3
+  double gravity = 9.81;                    ///< m/s^2
+  bool rotational_damping = true;           ///< drag integrated over the polygon (gives torque)
+  double drag_reference_speed = 0.0;        ///< m/s; > 0: drag linearised, |u| replaced by this
+  bool added_mass_in_contacts = false;      ///< true: contacts see m + m_a too
+  bool water_drag = false, air_drag = false;///< which drag terms any body needs
+
+  /// The current at a depth (m below the surface).
+  Vec2 current_at(double depth) const;
+};
+
+/// [tow]: an iceberg moved on a prescribed velocity, or pulled by a rope from a tug.
+struct TowSpec {
+  enum class Mode : std::uint8_t { none, velocity, rope };
+  Mode mode = Mode::none;
+  std::size_t body = 0;
+  /// Piecewise-linear velocity against time [(t, v)], held after the last point. The towed
+  /// body's (mode velocity) or the tug's (mode rope).
+  std::vector<std::pair<double, Vec2>> path;
+  double stiffness = 0.0;          ///< N/m (rope)
+  double length = 0.0;             ///< m, unstretched (rope)
+  double damping = 0.0;            ///< N s/m (rope)
+  Vec2 attachment;                 ///< m, in the body's frame from its centroid (rope)
+  Vec2 tug_start;                  ///< m, world (rope)
+  Vec2 velocity_at(double t) const;
+  Vec2 acceleration_at(double t) const;
+  Vec2 displacement(double t0, double t1) const;  ///< integral of the path velocity
 };
 
 struct Scene {
@@ -65,12 +147,18 @@ struct Scene {
   ContactSettings contact;
   OutputSettings output;
   std::vector<BodySpec> bodies;
+  bool has_environment = false;
+  EnvironmentSpec environment;
+  TowSpec tow;
 
   /// [engine.NAME] tables, kept as written: each engine reads and checks its own.
   std::map<std::string, toml::table> engine_settings;
 
   /// Fills each body's derived fields. Throws InputError for a degenerate polygon.
   void derive();
+  /// Mass the engines move: m, plus the added mass when it enters contacts too.
+  double engine_mass(std::size_t body) const;
+  double engine_inertia(std::size_t body) const;
 };
 
 }  // namespace floedem

@@ -42,11 +42,11 @@ class NativeEngine final : public Engine {
 
   NativeSettings settings_;
   ContactSettings contact_;
-  ContactOutput contact_output_;
   double dt_;
 
   // Hot: touched every step.
   BodyArrays bodies_;
+  std::vector<std::uint8_t> moves_;        // 0 for fixed bodies
   std::vector<std::int32_t> part_body_;
   std::vector<std::uint8_t> part_fixed_;
   std::vector<std::int32_t> part_first_;   // first vertex of part k; part k has part_first_[k+1]-part_first_[k]
@@ -71,7 +71,6 @@ class NativeEngine final : public Engine {
 NativeEngine::NativeEngine(const Scene& scene)
     : settings_(read_native_settings(scene)),
       contact_(scene.contact),
-      contact_output_(scene.output.contacts),
       dt_(scene.run.dt) {
   const std::size_t n = scene.bodies.size();
   bodies_.position.resize(n);
@@ -81,14 +80,18 @@ NativeEngine::NativeEngine(const Scene& scene)
   bodies_.angular_velocity.resize(n);
   bodies_.inv_mass.resize(n);
   bodies_.inv_inertia.resize(n);
+  moves_.resize(n);
   part_first_.push_back(0);
   for (std::size_t i = 0; i < n; ++i) {
     const BodySpec& b = scene.bodies[i];
     bodies_.position[i] = b.centroid;
     bodies_.velocity[i] = b.velocity;
     bodies_.angular_velocity[i] = b.angular_velocity;
-    bodies_.inv_mass[i] = b.fixed ? 0.0 : 1.0 / b.mass;
-    bodies_.inv_inertia[i] = b.fixed ? 0.0 : 1.0 / b.inertia;
+    // Fixed and prescribed (towed at a given velocity) bodies have infinite mass in contacts.
+    const bool infinite = b.fixed || b.prescribed;
+    bodies_.inv_mass[i] = infinite ? 0.0 : 1.0 / scene.engine_mass(i);
+    bodies_.inv_inertia[i] = infinite ? 0.0 : 1.0 / scene.engine_inertia(i);
+    moves_[i] = b.fixed ? 0 : 1;
     for (const auto& part : b.local_parts) {
       double radius = 0.0;
       const std::size_t m = part.size();
@@ -99,7 +102,7 @@ NativeEngine::NativeEngine(const Scene& scene)
         radius = std::max(radius, length(part[k]));
       }
       part_body_.push_back(static_cast<std::int32_t>(i));
-      part_fixed_.push_back(b.fixed ? 1 : 0);
+      part_fixed_.push_back(b.fixed || b.prescribed ? 1 : 0);
       part_first_.push_back(static_cast<std::int32_t>(local_vertices_.size()));
       part_radius_.push_back(radius);
     }
@@ -130,7 +133,13 @@ EngineInfo NativeEngine::info() const {
 }
 
 void NativeEngine::step(const Loads* loads) {
-  if (loads && !loads->any) loads = nullptr;  // nothing to add: skip the pass
+  if (loads) {
+    for (const PrescribedMotion& p : loads->prescribed) {
+      bodies_.velocity[p.body] = p.velocity;
+      bodies_.angular_velocity[p.body] = p.angular_velocity;
+    }
+    if (!loads->any) loads = nullptr;  // no forces to add: skip the pass
+  }
   find_pairs(loads);                           // 1. pairs
   build_manifolds();                           // 2. manifolds, classified on the velocities before the step
   if (loads) apply_loads(*loads);              // 3. non-contact forces
@@ -282,7 +291,7 @@ void NativeEngine::apply_loads(const Loads& loads) {
 void NativeEngine::integrate() {
   const std::size_t nb = bodies_.position.size();
   for (std::size_t i = 0; i < nb; ++i) {
-    if (bodies_.inv_mass[i] == 0.0) continue;
+    if (!moves_[i]) continue;
     bodies_.position[i] += dt_ * bodies_.velocity[i];
     if (bodies_.angular_velocity[i] != 0.0) {
       bodies_.angle[i] += dt_ * bodies_.angular_velocity[i];
@@ -293,12 +302,10 @@ void NativeEngine::integrate() {
 
 void NativeEngine::record() {
   records_.clear();
-  if (contact_output_ == ContactOutput::none) return;
   for (const Manifold& m : manifolds_) {
     for (int k = 0; k < m.point_count; ++k) {
       const ManifoldPoint& p = m.points[k];
       if (p.normal_impulse == 0.0 && p.tangent_impulse == 0.0) continue;
-      if (contact_output_ == ContactOutput::collisions && p.kind != ContactKind::collision) continue;
       records_.push_back(ContactRecord{m.body_a, m.body_b, p.point, m.normal, p.normal_impulse, p.tangent_impulse,
                                        p.approach_velocity, p.separation, p.kind});
     }

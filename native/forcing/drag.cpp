@@ -1,0 +1,82 @@
+#include "forcing/drag.hpp"
+
+#include <cmath>
+
+namespace floedem {
+
+std::vector<EdgePoint> edge_points(const std::vector<Vec2>& poly) {
+  std::vector<EdgePoint> out;
+  const std::size_t n = poly.size();
+  const double g = 0.5 / std::sqrt(3.0);  // Gauss points at 1/2 -+ 1/(2 sqrt 3)
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2 a = poly[k], b = poly[(k + 1) % n];
+    const double len = length(b - a);
+    if (len == 0.0) continue;
+    const Vec2 normal{(b - a).y / len, -(b - a).x / len};
+    out.push_back({a + (0.5 - g) * (b - a), normal, 0.5 * len});
+    out.push_back({a + (0.5 + g) * (b - a), normal, 0.5 * len});
+  }
+  return out;
+}
+
+std::vector<AreaPoint> area_points(const std::vector<Vec2>& poly) {
+  std::vector<AreaPoint> out;
+  const std::size_t n = poly.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2 a = poly[k], b = poly[(k + 1) % n];
+    const double third = cross(a, b) / 6.0;  // a third of the triangle (0, a, b)
+    out.push_back({0.5 * a, third});
+    out.push_back({0.5 * b, third});
+    out.push_back({0.5 * (a + b), third});
+  }
+  return out;
+}
+
+void add_form_drag(ForceSums& sums, std::size_t body, const std::vector<EdgePoint>& edges, double scale, double c,
+                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& s) {
+  for (const EdgePoint& e : edges) {
+    const Vec2 r = rot.apply(scale * e.r);
+    const Vec2 n = rot.apply(e.normal);
+    const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
+    const double un = dot(u, n);
+    if (un >= 0.0) continue;  // the flow leaves this edge: no pressure on it
+    const double k = c * scale * e.length;
+    std::array<double, 4> a;
+    Vec2 f;
+    if (s.reference_speed > 0.0) {
+      // Linearised: |u| -> U_ref, so dF = k U_ref cos(theta) u with cos(theta) = -u.n / |u|.
+      const double cos_theta = -un / length(u);
+      f = (k * s.reference_speed * cos_theta) * u;
+      a = {k * s.reference_speed * cos_theta, 0.0, 0.0, k * s.reference_speed * cos_theta};
+    } else {
+      // dF = k (-u.n) u,  dF/du = k ((-u.n) I - u n^T).
+      f = (-k * un) * u;
+      a = {k * (-un - u.x * n.x), -k * u.x * n.y, -k * u.y * n.x, k * (-un - u.y * n.y)};
+    }
+    sums.add_point_force(body, r, f, a, s.rotational);
+  }
+}
+
+void add_skin_drag(ForceSums& sums, std::size_t body, const std::vector<AreaPoint>& points, double scale, double c,
+                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& s) {
+  for (const AreaPoint& p : points) {
+    const Vec2 r = rot.apply(scale * p.r);
+    const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
+    const double k = c * scale * scale * p.area;
+    std::array<double, 4> a;
+    Vec2 f;
+    if (s.reference_speed > 0.0) {
+      f = (k * s.reference_speed) * u;
+      a = {k * s.reference_speed, 0.0, 0.0, k * s.reference_speed};
+    } else {
+      // dF = k |u| u,  dF/du = k (|u| I + u u^T / |u|).
+      const double m = length(u);
+      f = (k * m) * u;
+      const double inv = m > 0.0 ? 1.0 / m : 0.0;
+      a = {k * (m + u.x * u.x * inv), k * u.x * u.y * inv, k * u.x * u.y * inv, k * (m + u.y * u.y * inv)};
+    }
+    sums.add_point_force(body, r, f, a, s.rotational);
+  }
+}
+
+}  // namespace floedem

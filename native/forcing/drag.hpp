@@ -1,0 +1,47 @@
+#pragma once
+// Quadrature of drag over a body's waterline polygon (shared by the drag terms).
+//
+// Form drag on an edge element of length dl (outward normal n) that faces the relative flow
+// u = V - (v + w k x r) (u.n < 0), per unit height:  dF = 1/2 rho C (-u.n) u dl.
+// Summed over a convex outline in a uniform flow, sum dl max(0, -n.u^) is the projected
+// width normal to the flow, so F = 1/2 rho C (W h) |u| u: the form drag of MODEL.md 2 with the
+// width measured on the polygon. Skin drag on an area element: dF = rho C |u| u dA.
+// Integrating both over the polygon with the local velocity gives the rotational damping torque.
+// Edges: 2-point Gauss rule; area: centroid fan of signed triangles, 3-point edge-midpoint rule
+// (exact for quadratic integrands, hence exact in a uniform flow).
+#include <array>
+#include <vector>
+
+#include "forcing/force_term.hpp"
+
+namespace floedem {
+
+struct EdgePoint {
+  Vec2 r;        ///< body frame, from the centroid
+  Vec2 normal;   ///< body frame, outward
+  double length; ///< m of edge this point stands for
+};
+
+struct AreaPoint {
+  Vec2 r;
+  double area;  ///< m^2 this point stands for (signed for concave outlines)
+};
+
+std::vector<EdgePoint> edge_points(const std::vector<Vec2>& local_polygon);
+std::vector<AreaPoint> area_points(const std::vector<Vec2>& local_polygon);
+
+struct DragSettings {
+  bool rotational = true;        ///< use the local velocity and add the torque
+  double reference_speed = 0.0;  ///< > 0: |u| replaced by this (linearised drag)
+};
+
+/// Adds form drag of a slab (height h, outline scaled by s) in the flow V: coefficient
+/// c = 1/2 rho C h.
+void add_form_drag(ForceSums& sums, std::size_t body, const std::vector<EdgePoint>& edges, double scale, double c,
+                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings);
+
+/// Adds skin drag over an area (outline scaled by s): coefficient c = rho C.
+void add_skin_drag(ForceSums& sums, std::size_t body, const std::vector<AreaPoint>& points, double scale, double c,
+                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings);
+
+}  // namespace floedem

@@ -1,0 +1,65 @@
+#include "towing/tow.hpp"
+
+#include <algorithm>
+
+namespace floedem {
+
+RopeState rope_state(const TowSpec& tow, const BodyStates& s, double t) {
+  RopeState r;
+  r.tug = tow.tug_start + tow.displacement(0.0, t);
+  const std::size_t i = tow.body;
+  r.arm = Rot::from_angle(s.angle[i]).apply(tow.attachment);
+  const Vec2 point = s.position[i] + r.arm;
+  const Vec2 span = r.tug - point;
+  r.length = length(span);
+  if (r.length <= tow.length || r.length == 0.0) return r;  // slack
+  r.direction = (1.0 / r.length) * span;
+  // dL/dt = (v_tug - v_point) . e
+  const Vec2 point_velocity = s.velocity[i] + cross(s.angular_velocity[i], r.arm);
+  const double rate = dot(tow.velocity_at(t) - point_velocity, r.direction);
+  r.tension = std::max(0.0, tow.stiffness * (r.length - tow.length) + tow.damping * rate);
+  return r;
+}
+
+TowMonitor::TowMonitor(const Scene& scene) : scene_(scene), tow_(scene.tow) {}
+
+Vec2 TowMonitor::tug_position(double time) const {
+  if (tow_.mode == TowSpec::Mode::rope) return tow_.tug_start + tow_.displacement(0.0, time);
+  return scene_.bodies[tow_.body].centroid + tow_.displacement(0.0, time);
+}
+
+void TowMonitor::before_step(const BodyStates& state, double time) {
+  time_ = time;
+  if (tow_.mode == TowSpec::Mode::rope) rope_ = rope_state(tow_, state, time);
+}
+
+void TowMonitor::after_step(std::span<const ContactRecord> contacts, const std::array<double, 3>& env) {
+  if (tow_.mode == TowSpec::Mode::rope) {
+    force_ = rope_.tension * rope_.direction;
+  } else if (tow_.mode == TowSpec::Mode::velocity) {
+    const double dt = scene_.run.dt;
+    const BodySpec& b = scene_.bodies[tow_.body];
+    const std::int32_t body = static_cast<std::int32_t>(tow_.body);
+    Vec2 contact;
+    for (const ContactRecord& c : contacts) {
+      const Vec2 p = c.normal_impulse * c.normal + c.tangent_impulse * perp(c.normal);
+      if (c.body_b == body) contact += p;
+      if (c.body_a == body) contact -= p;
+    }
+    const double mi = b.mass * (1.0 + b.added_mass_coefficient);
+    const Vec2 inertial = mi * tow_.acceleration_at(time_ + 0.5 * dt);
+    // Rope-free forcing on the body at the start of the step (the rope term is absent here).
+    force_ = inertial - Vec2{env[0], env[1]} - (1.0 / dt) * contact;
+  }
+  sum_ += force_;
+  ++count_;
+}
+
+Vec2 TowMonitor::take_mean() {
+  const Vec2 m = count_ > 0 ? (1.0 / static_cast<double>(count_)) * sum_ : force_;
+  sum_ = {};
+  count_ = 0;
+  return m;
+}
+
+}  // namespace floedem
