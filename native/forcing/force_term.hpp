@@ -63,6 +63,7 @@ class Forcing {
   double dt_;
   ForceSums sums_;
   Loads loads_;
+  BodyStates moved_;  ///< the state with prescribed velocities (towing scenes only)
 };
 
 // Builders, one per term file.

@@ -95,12 +95,22 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
   }
   loads_.any = !terms_.empty();
   if (terms_.empty()) return &loads_;
+  // A prescribed body feels the forcing at the velocity it will have over the step.
+  const BodyStates* at = &state;
+  if (!prescribed_.empty()) {
+    moved_ = state;
+    for (const PrescribedMotion& p : loads_.prescribed) {
+      moved_.velocity[p.body] = p.velocity;
+      moved_.angular_velocity[p.body] = p.angular_velocity;
+    }
+    at = &moved_;
+  }
 
   std::fill(sums_.q.begin(), sums_.q.end(), std::array<double, 3>{});
   if (sums_.any_jacobian) std::fill(sums_.dq.begin(), sums_.dq.end(), std::array<double, 9>{});
   if (sums_.any_rotation) std::fill(sums_.rotation_rate.begin(), sums_.rotation_rate.end(), 0.0);
   sums_.any_jacobian = sums_.any_rotation = false;
-  for (const auto& t : terms_) t->add(state, time, sums_);
+  for (const auto& t : terms_) t->add(*at, time, sums_);
 
   const std::size_t n = scene_.bodies.size();
   const bool first_step = time == 0.0;

@@ -1,0 +1,126 @@
+// Towing against closed forms (issue 3).
+#include <catch2/catch.hpp>
+
+#include <H5Cpp.h>
+
+#include <filesystem>
+
+#include "run/simulation.hpp"
+#include "support.hpp"
+#include "towing/tow.hpp"
+
+using namespace floedem;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A tabular iceberg 200 m x 100 m at the waterline, 80 m draft, 20 m sail, mass given.
+const std::string kBerg =
+    "[[body]]\nname = \"berg\"\nkind = \"iceberg\"\npolygon = [[-100,-50],[100,-50],[100,50],[-100,50]]\n"
+    "draft = 80.0\nsail_height = 20.0\nmass = 1.5e9\n";
+
+/// Calm-water drag on the iceberg moving at speed v along x (N, opposing the motion).
+double drag_at(double v) {
+  const double w = 100.0, area = 200.0 * 100.0;
+  return 0.5 * 1025.0 * 0.9 * w * 80.0 * v * v + 1025.0 * 5e-4 * area * v * v + 0.5 * 1.25 * 1.3 * w * 20.0 * v * v +
+         1.25 * 2.5e-4 * area * v * v;
+}
+
+}  // namespace
+
+TEST_CASE("towing at constant speed in calm open water: the towing force is the drag", "[tow]") {
+  const std::string text = "[run]\nduration = 100.0\ndt = 0.5\n[environment]\n" + kBerg +
+                           "[tow]\nmode = \"velocity\"\nbody = \"berg\"\nvelocity = [0.7, 0.0]\n";
+  const Scene s = test::scene_from(text);
+  auto e = test::native(s);
+  Forcing forcing(s);
+  TowMonitor tow(s);
+  for (int n = 0; n < 200; ++n) {
+    tow.before_step(e->state(), n * 0.5);
+    e->step(forcing.evaluate(e->state(), n * 0.5));
+    tow.after_step(e->contacts(), forcing.environment_force(0));
+    // 1e-6 relative: the issue's bound; both sides are the same closed form up to round-off.
+    CHECK(tow.force().x == Approx(drag_at(0.7)).epsilon(1e-6));
+    CHECK(std::abs(tow.force().y) < 1e-9 * drag_at(0.7));
+  }
+  CHECK(e->state().position[0].x == Approx(0.7 * 100.0).epsilon(1e-12));
+  CHECK(e->state().velocity[0].x == 0.7);
+}
+
+TEST_CASE("towing on a piecewise-linear path: the body follows it and pays for its acceleration", "[tow]") {
+  const std::string text = "[run]\nduration = 200.0\ndt = 0.5\n[environment]\n" + kBerg +
+                           "[tow]\nmode = \"velocity\"\nbody = \"berg\"\npath = [[0, 0.0, 0.0], [100, 0.5, 0.0]]\n";
+  const Scene s = test::scene_from(text);
+  auto e = test::native(s);
+  Forcing forcing(s);
+  TowMonitor tow(s);
+  for (int n = 0; n < 400; ++n) {
+    tow.before_step(e->state(), n * 0.5);
+    e->step(forcing.evaluate(e->state(), n * 0.5));
+    tow.after_step(e->contacts(), forcing.environment_force(0));
+    if (n == 99) {
+      // Mid-way up the ramp, the step from 49.5 s to 50 s: m_I a + drag at the mid-step speed,
+      // the velocity the body is moved with over the step.
+      const double v = 0.005 * 49.75;
+      CHECK(tow.force().x == Approx(1.5e9 * 1.5 * 0.005 + drag_at(v)).epsilon(1e-9));
+    }
+  }
+  // Displacement: 1/2 0.5 m/s 100 s + 0.5 m/s 100 s = 75 m, exact for the piecewise-linear path.
+  CHECK(e->state().position[0].x == Approx(75.0).epsilon(1e-12));
+}
+
+TEST_CASE("rope towing in steady state: the rope carries the drag", "[tow]") {
+  // Tug at 0.5 m/s, rope 300 m, k = 1e5 N/m, damping about critical for m_I = 2.25e9 kg.
+  const std::string text = "[run]\nduration = 30000.0\ndt = 1.0\noutput_every = 100\n[environment]\n" + kBerg +
+                           "[tow]\nmode = \"rope\"\nbody = \"berg\"\ntug_velocity = [0.5, 0.0]\nstiffness = 1e5\n"
+                           "length = 300.0\ndamping = 3e7\nattachment = [100.0, 0.0]\n";
+  const Scene s = test::scene_from(text);
+  CHECK(s.tow.tug_start.x == Approx(400.0));  // attachment + rope length along the tug's heading
+  auto e = test::native(s);
+  Forcing forcing(s);
+  TowMonitor tow(s);
+  for (int n = 0; n < 30000; ++n) {
+    tow.before_step(e->state(), n * 1.0);
+    e->step(forcing.evaluate(e->state(), n * 1.0));
+    tow.after_step(e->contacts(), forcing.environment_force(0));
+  }
+  // 1e-4 relative: the issue's bound. 30 000 s is ~20 drag time scales m_I / (K v).
+  CHECK(tow.force().x == Approx(drag_at(0.5)).epsilon(1e-4));
+  CHECK(e->state().velocity[0].x == Approx(0.5).epsilon(1e-4));
+  CHECK(std::abs(e->state().angle[0]) < 1e-9);  // pulled from ahead of its centroid: stays on course
+}
+
+TEST_CASE("a slack rope carries nothing", "[tow]") {
+  const std::string text = "[run]\nduration = 10.0\ndt = 1.0\n[environment]\n" + kBerg +
+                           "[tow]\nmode = \"rope\"\nbody = \"berg\"\ntug_velocity = [-0.5, 0.0]\nstiffness = 1e5\n"
+                           "length = 300.0\nattachment = [100.0, 0.0]\ntug_start = [300.0, 0.0]\n";
+  const Scene s = test::scene_from(text);
+  BodyStates st;
+  st.resize(1);
+  const RopeState r = rope_state(s.tow, st, 0.0);
+  CHECK(r.length == Approx(200.0));
+  CHECK(r.tension == 0.0);
+}
+
+TEST_CASE("tow output: /tow/force and /tow/tug_position per frame", "[tow][output]") {
+  const std::string text = "[run]\nduration = 10.0\ndt = 0.5\noutput_every = 2\n[environment]\n" + kBerg +
+                           "[tow]\nmode = \"velocity\"\nbody = \"berg\"\nvelocity = [0.7, 0.0]\n";
+  const Scene s = test::scene_from(text);
+  const fs::path out = fs::temp_directory_path() / ("floedem-tow-" + std::to_string(::getpid()) + ".h5");
+  RunOptions o;
+  o.output = out.string();
+  run_scene(s, o);
+  H5::H5File f(out.string(), H5F_ACC_RDONLY);
+  H5::DataSet force = f.openDataSet("/tow/force");
+  hsize_t dims[2];
+  force.getSpace().getSimpleExtentDims(dims);
+  CHECK(dims[0] == 11);  // t = 0 and 10 frames
+  CHECK(dims[1] == 2);
+  std::vector<double> v(22), tug(22);
+  force.read(v.data(), H5::PredType::NATIVE_DOUBLE);
+  f.openDataSet("/tow/tug_position").read(tug.data(), H5::PredType::NATIVE_DOUBLE);
+  CHECK(std::isnan(v[0]));  // no step before t = 0
+  CHECK(v[2] == Approx(drag_at(0.7)).epsilon(1e-6));
+  CHECK(tug[20] == Approx(7.0).epsilon(1e-12));  // the path's position at t = 10 s
+  fs::remove(out);
+}
