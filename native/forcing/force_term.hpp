@@ -53,8 +53,9 @@ class Forcing {
   std::vector<std::string_view> names() const;
   /// Loads for the step that starts at `time`, or nullptr when the scene has no forcing.
   const Loads* evaluate(const BodyStates& state, double time);
-  /// The generalised force of all terms on body i at the start of the last evaluated step.
-  std::array<double, 3> environment_force(std::size_t i) const { return sums_.q[i]; }
+  /// The generalised force of all terms on prescribed (towed) body i over the last evaluated
+  /// step, Coriolis included (-m f k x v at its prescribed velocity). Towing reads it.
+  std::array<double, 3> environment_force(std::size_t i) const;
 
  private:
   std::vector<std::unique_ptr<ForceTerm>> terms_;

@@ -43,6 +43,16 @@ std::array<double, 3> solve3(const std::array<double, 9>& a, const std::array<do
 }
 }  // namespace
 
+std::array<double, 3> Forcing::environment_force(std::size_t i) const {
+  std::array<double, 3> q = sums_.q[i];
+  if (sums_.any_rotation && scene_.bodies[i].prescribed) {
+    const double mf = scene_.bodies[i].mass * sums_.rotation_rate[i];
+    q[0] += mf * moved_.velocity[i].y;
+    q[1] -= mf * moved_.velocity[i].x;
+  }
+  return q;
+}
+
 void ForceSums::add_point_force(std::size_t i, Vec2 r, Vec2 f, const std::array<double, 4>& a, bool with_torque) {
   // G = [[1, 0, -r_y], [0, 1, r_x]] maps q to the point's velocity.
   const double gx = with_torque ? -r.y : 0.0, gy = with_torque ? r.x : 0.0;
