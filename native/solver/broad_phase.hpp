@@ -1,12 +1,14 @@
 #pragma once
 // Broad phase: pairs of convex parts whose (fattened) bounds overlap.
 //
-// A uniform grid rebuilt every step by counting sort: O(N) for a field of floes of comparable
-// size, no allocation once its buffers have grown. The cell size follows the median part size,
-// so a power-law field (many small floes, few large) keeps few parts per cell; parts that would
-// cover many cells (an iceberg) are kept out of the grid and tested against every box, which is
-// O(N) per such part. A pair is reported only from the cell holding the lower-left corner of the
-// two boxes' intersection, so every pair appears once, in a deterministic order, sorted at the end.
+// A hierarchical uniform grid rebuilt every step by counting sort. Level l has cells of side
+// h_0 2^l, with h_0 the median part extent; each part goes to the finest level whose cells are
+// at least its size, so it covers at most 2 x 2 cells there. A part is tested against the parts
+// of its own cells and of the cells it covers on every coarser level. For a field of floes with
+// a power-law size spread (and an iceberg far larger than any floe) that is O(N log(d_max /
+// d_median)), with no allocation once the buffers have grown. A pair is reported only from the
+// cell (of the coarser part's level) that holds the lower-left corner of the two boxes'
+// intersection, so each pair appears once; the list is sorted at the end (deterministic).
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -25,17 +27,25 @@ struct PartPair {
 class BroadPhase {
  public:
   /// boxes[k]: bounds of part k; body[k]: its body (parts of one body never pair);
-  /// fixed[k]: non-zero when part k's body cannot move (two fixed parts never pair).
+  /// fixed[k]: non-zero when part k's body cannot move (two such parts never pair).
   void find_pairs(std::span<const Aabb> boxes, std::span<const std::int32_t> body,
                   std::span<const std::uint8_t> fixed, std::vector<PartPair>& out);
 
  private:
+  struct Level {
+    double h = 0.0;
+    double inv_h = 0.0;
+    std::int64_t nx = 0, ny = 0;
+    std::vector<std::int32_t> cell_start;  // CSR over cells
+    std::vector<std::int32_t> items;
+    std::int64_t count = 0;                // parts on this level
+    std::int64_t cell_x(double x, double x0) const;
+    std::int64_t cell_y(double y, double y0) const;
+  };
   std::vector<double> extents_;
-  std::vector<std::int32_t> cell_start_;
-  std::vector<std::int32_t> cell_items_;
+  std::vector<std::uint8_t> level_of_;
+  std::vector<Level> levels_;
   std::vector<std::int32_t> cursor_;
-  std::vector<std::int32_t> large_;
-  std::vector<std::uint8_t> is_large_;
 };
 
 }  // namespace floedem

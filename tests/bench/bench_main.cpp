@@ -1,0 +1,92 @@
+// Micro-benchmarks of the hot loops (Google Benchmark). Not tests: run them with
+//   build/floedem_bench --benchmark_out=reports/bench/$(hostname).csv --benchmark_out_format=csv
+// (the `bench` target does this).
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "engine/registry.hpp"
+#include "forcing/force_term.hpp"
+#include "scenario/scenario.hpp"
+#include "solver/broad_phase.hpp"
+
+using namespace floedem;
+
+namespace {
+
+/// N boxes with power-law sizes (d^-2, 2 to 60 m) at about 50 % cover.
+void power_law_boxes(int n, std::vector<Aabb>& boxes, std::vector<std::int32_t>& body, std::vector<std::uint8_t>& fixed) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double area = 0.0;
+  std::vector<double> sizes;
+  for (int i = 0; i < n; ++i) {
+    const double d = 2.0 / std::sqrt(1.0 - u(rng) * (1.0 - (2.0 / 60.0) * (2.0 / 60.0)));  // truncated Pareto, alpha 2
+    sizes.push_back(d);
+    area += d * d;
+  }
+  const double side = std::sqrt(area / 0.5);
+  for (int i = 0; i < n; ++i) {
+    const Vec2 c{u(rng) * side, u(rng) * side};
+    boxes.push_back({c - 0.5 * Vec2{sizes[i], sizes[i]}, c + 0.5 * Vec2{sizes[i], sizes[i]}});
+    body.push_back(i);
+    fixed.push_back(0);
+  }
+}
+
+void BM_BroadPhase(benchmark::State& state) {
+  std::vector<Aabb> boxes;
+  std::vector<std::int32_t> body;
+  std::vector<std::uint8_t> fixed;
+  power_law_boxes(static_cast<int>(state.range(0)), boxes, body, fixed);
+  BroadPhase bp;
+  std::vector<PartPair> pairs;
+  for (auto _ : state) {
+    bp.find_pairs(boxes, body, fixed, pairs);
+    benchmark::DoNotOptimize(pairs.data());
+  }
+  state.counters["pairs"] = static_cast<double>(pairs.size());
+  state.counters["ns_per_box"] = benchmark::Counter(static_cast<double>(state.range(0)),
+                                                    benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_BroadPhase)->RangeMultiplier(10)->Range(1000, 100000)->Complexity(benchmark::oN)->Unit(benchmark::kMicrosecond);
+
+/// A row of N separated floes (no contacts): the step cost of forcing and integration alone.
+std::string spread_floes(int n, const std::string& environment) {
+  std::string t = "[run]\nduration = 1e6\ndt = 1.0\n" + environment;
+  for (int i = 0; i < n; ++i) {
+    const double x = 30.0 * i;
+    t += "[[body]]\npolygon = [[" + std::to_string(x) + ",0],[" + std::to_string(x + 10) + ",0],[" +
+         std::to_string(x + 10) + ",10],[" + std::to_string(x) + ",10]]\nthickness = 1\nvelocity = [0.1, 0.0]\n";
+  }
+  return t;
+}
+
+void step_scene(benchmark::State& state, const std::string& environment) {
+  const Scene s = parse_scenario(spread_floes(static_cast<int>(state.range(0)), environment), "bench.toml");
+  auto engine = make_engine("native", s);
+  Forcing forcing(s);
+  double t = 0.0;
+  for (auto _ : state) {
+    engine->step(forcing.evaluate(engine->state(), t));
+    t += 1.0;
+  }
+  state.counters["terms"] = static_cast<double>(forcing.names().size());
+}
+
+const std::string kNoDrag =
+    "[environment.drag]\nwater_form = 0.0\nwater_skin = 0.0\nair_form = 0.0\nair_skin = 0.0\n";
+
+void BM_StepNoEnvironment(benchmark::State& state) { step_scene(state, ""); }
+void BM_StepCoriolisOnly(benchmark::State& state) { step_scene(state, "[environment]\nlatitude = 75.0\n" + kNoDrag); }
+void BM_StepFullEnvironment(benchmark::State& state) {
+  step_scene(state, "[environment]\nlatitude = 75.0\nwind = [7.0, 7.0]\ncurrent = [0.1, 0.0]\n[environment.waves]\namplitude = 1.0\nperiod = 8.0\n");
+}
+BENCHMARK(BM_StepNoEnvironment)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_StepCoriolisOnly)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_StepFullEnvironment)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
