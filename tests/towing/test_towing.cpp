@@ -47,6 +47,22 @@ TEST_CASE("towing at constant speed in calm open water: the towing force is the 
   CHECK(e->state().velocity[0].x == 0.7);
 }
 
+TEST_CASE("towing with Coriolis: the constraint also holds the Coriolis force", "[tow]") {
+  const std::string text = "[run]\nduration = 10.0\ndt = 0.5\n[environment]\nlatitude = 75.0\n" + kBerg +
+                           "[tow]\nmode = \"velocity\"\nbody = \"berg\"\nvelocity = [0.7, 0.0]\n";
+  const Scene s = test::scene_from(text);
+  auto e = test::native(s);
+  Forcing forcing(s);
+  TowMonitor tow(s);
+  tow.before_step(e->state(), 0.0);
+  e->step(forcing.evaluate(e->state(), 0.0));
+  tow.after_step(e->contacts(), forcing.environment_force(0));
+  // -m f k x v = (0, -m f v) for v along x: the tow must supply +m f v across the path.
+  const double f = 2.0 * 7.2921e-5 * std::sin(75.0 * M_PI / 180.0);
+  CHECK(tow.force().y == Approx(1.5e9 * f * 0.7).epsilon(1e-12));
+  CHECK(tow.force().x == Approx(drag_at(0.7)).epsilon(1e-9));
+}
+
 TEST_CASE("towing on a piecewise-linear path: the body follows it and pays for its acceleration", "[tow]") {
   const std::string text = "[run]\nduration = 200.0\ndt = 0.5\n[environment]\n" + kBerg +
                            "[tow]\nmode = \"velocity\"\nbody = \"berg\"\npath = [[0, 0.0, 0.0], [100, 0.5, 0.0]]\n";
