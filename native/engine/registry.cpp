@@ -1,6 +1,7 @@
 #include "engine/registry.hpp"
 
 #include "scene/input_error.hpp"
+#include "reference/box2d/box2d_engine.hpp"
 #include "solver/native_engine.hpp"
 
 namespace floedem {
@@ -9,6 +10,8 @@ const std::vector<EngineEntry>& engines() {
   static const std::vector<EngineEntry> table = {
       {"native", "floedem's planar non-smooth DEM (sequential impulses, exact local Coulomb solve)",
        make_native_engine},
+      {"box2d", "Box2D 2.4 (reference): the polygons themselves, restitution threshold 0, polygon radius 0",
+       make_box2d_engine},
   };
   return table;
 }

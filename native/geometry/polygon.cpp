@@ -137,3 +137,37 @@ Aabb bounds_of(std::span<const Vec2> pts) {
 }
 
 }  // namespace floedem
+
+namespace floedem {
+
+std::vector<std::vector<Vec2>> split_convex(const std::vector<Vec2>& poly, std::size_t max_vertices) {
+  const std::size_t n = poly.size();
+  if (n <= max_vertices) return {poly};
+  std::vector<std::vector<Vec2>> out;
+  // Pieces (0, k, k+1, ..., k+m-2): each adds up to max_vertices - 2 new vertices.
+  std::size_t k = 1;
+  while (k + 1 < n) {
+    const std::size_t last = std::min(n - 1, k + max_vertices - 2);
+    std::vector<Vec2> piece{poly[0]};
+    for (std::size_t j = k; j <= last; ++j) piece.push_back(poly[j]);
+    out.push_back(std::move(piece));
+    k = last;
+  }
+  return out;
+}
+
+std::vector<Vec2> inset_convex(const std::vector<Vec2>& poly, double distance) {
+  const std::size_t n = poly.size();
+  std::vector<Vec2> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    // Vertex i joins edge (i-1, i) and edge (i, i+1); both move inward along their normals.
+    const Vec2 a = poly[(i + n - 1) % n], b = poly[i], c = poly[(i + 1) % n];
+    const Vec2 e0 = normalized(b - a), e1 = normalized(c - b);
+    const Vec2 n0 = perp(e0), n1 = perp(e1);  // inward (left) normals of a ccw polygon
+    // b + distance * (n0 + n1) / (1 + n0.n1) lies at `distance` from both edges.
+    out.push_back(b + (distance / (1.0 + dot(n0, n1))) * (n0 + n1));
+  }
+  return out;
+}
+
+}  // namespace floedem

@@ -42,3 +42,15 @@ std::vector<Vec2> remove_collinear(std::span<const Vec2> poly, double relative_t
 Aabb bounds_of(std::span<const Vec2> pts);
 
 }  // namespace floedem
+
+namespace floedem {
+
+/// Splits a convex counter-clockwise polygon into convex pieces of at most `max_vertices`
+/// (>= 3) vertices each, as a fan of consecutive vertex runs from vertex 0.
+std::vector<std::vector<Vec2>> split_convex(const std::vector<Vec2>& poly, std::size_t max_vertices);
+
+/// Moves every edge of a convex counter-clockwise polygon inward by `distance` (m) and returns
+/// the polygon of the moved edges' intersections (an inward parallel offset).
+std::vector<Vec2> inset_convex(const std::vector<Vec2>& poly, double distance);
+
+}  // namespace floedem

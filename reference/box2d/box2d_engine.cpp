@@ -1,0 +1,210 @@
+// Box2D 2.4 as a reference engine: the scene's polygons themselves (convex parts of at most
+// 8 vertices), mass and inertia set to floedem's values, not Box2D's.
+// Settings that matter (measured in shared/notes/reference-engines.md):
+//  - restitution threshold 0 on every fixture: the default 1 m/s turns every drift-speed
+//    impact into e = 0;
+//  - polygon radius 0: the default 0.01 m skin moves the contact point off the vertex and
+//    changes the friction lever arm (errors 6e-4 to 2e-3 against the exact answer);
+//  - no sleeping, no continuous collision (not needed at drift speeds, 17 % of the step);
+//  - single precision: coordinates are taken relative to the scene's mean centroid.
+#include "reference/box2d/box2d_engine.hpp"
+
+#include <box2d/box2d.h>
+
+#include <unordered_map>
+
+#include "geometry/polygon.hpp"
+#include "scenario/table_reader.hpp"
+
+namespace floedem {
+
+namespace {
+
+struct Box2dSettings {
+  int velocity_iterations = 10;
+  int position_iterations = 3;
+  double polygon_radius = 0.0;  ///< m
+};
+
+Box2dSettings read_settings(const Scene& scene) {
+  Box2dSettings s;
+  const auto it = scene.engine_settings.find("box2d");
+  if (it == scene.engine_settings.end()) return s;
+  TableReader r(it->second, scene.source_path, "engine.box2d");
+  s.velocity_iterations = static_cast<int>(r.integer("velocity_iterations", s.velocity_iterations, 1, 100000));
+  s.position_iterations = static_cast<int>(r.integer("position_iterations", s.position_iterations, 0, 100000));
+  s.polygon_radius = r.real("polygon_radius", s.polygon_radius, Range::non_negative());
+  r.reject_unknown();
+  return s;
+}
+
+class Box2dEngine final : public Engine, public b2ContactListener {
+ public:
+  explicit Box2dEngine(const Scene& scene);
+  void step(const Loads* loads) override;
+  const BodyStates& state() const override { return state_; }
+  std::span<const ContactRecord> contacts() const override { return records_; }
+  EngineInfo info() const override;
+
+  // b2ContactListener
+  void PreSolve(b2Contact* contact, const b2Manifold* old_manifold) override;
+  void PostSolve(b2Contact* contact, const b2ContactImpulse* impulse) override;
+
+ private:
+  void publish();
+  Vec2 point_velocity(const b2Body* b, b2Vec2 p) const {
+    const b2Vec2 v = b->GetLinearVelocityFromWorldPoint(p);
+    return {v.x, v.y};
+  }
+
+  Box2dSettings settings_;
+  double dt_;
+  double threshold_;
+  Vec2 origin_;  // world = origin + Box2D coordinates
+  b2World world_{b2Vec2(0.0f, 0.0f)};
+  std::vector<b2Body*> bodies_;
+  std::unordered_map<const b2Body*, std::int32_t> index_;
+  std::unordered_map<const b2Contact*, std::array<double, 2>> approach_;
+  std::vector<ContactRecord> records_;
+  BodyStates state_;
+};
+
+Box2dEngine::Box2dEngine(const Scene& scene)
+    : settings_(read_settings(scene)), dt_(scene.run.dt), threshold_(scene.contact.collision_threshold) {
+  for (const BodySpec& b : scene.bodies) origin_ += b.centroid;
+  origin_ = (1.0 / static_cast<double>(scene.bodies.size())) * origin_;
+  world_.SetAllowSleeping(false);
+  world_.SetContinuousPhysics(false);
+  world_.SetContactListener(this);
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const BodySpec& spec = scene.bodies[i];
+    b2BodyDef def;
+    def.type = spec.fixed ? b2_staticBody : spec.prescribed ? b2_kinematicBody : b2_dynamicBody;
+    def.position.Set(static_cast<float>(spec.centroid.x - origin_.x), static_cast<float>(spec.centroid.y - origin_.y));
+    def.angle = 0.0f;
+    def.linearVelocity.Set(static_cast<float>(spec.velocity.x), static_cast<float>(spec.velocity.y));
+    def.angularVelocity = static_cast<float>(spec.angular_velocity);
+    def.allowSleep = false;
+    b2Body* body = world_.CreateBody(&def);
+    for (const auto& part : spec.local_parts) {
+      for (const auto& piece : split_convex(part, b2_maxPolygonVertices)) {
+        std::vector<b2Vec2> pts;
+        for (const Vec2 p : piece) pts.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+        b2PolygonShape shape;
+        shape.Set(pts.data(), static_cast<int32>(pts.size()));
+        shape.m_radius = static_cast<float>(settings_.polygon_radius);
+        b2FixtureDef fd;
+        fd.shape = &shape;
+        fd.density = 1.0f;  // replaced by SetMassData below
+        fd.friction = static_cast<float>(scene.contact.friction);
+        fd.restitution = static_cast<float>(scene.contact.restitution);
+        fd.restitutionThreshold = 0.0f;
+        body->CreateFixture(&fd);
+      }
+    }
+    if (def.type == b2_dynamicBody) {
+      b2MassData md;
+      md.mass = static_cast<float>(scene.engine_mass(i));
+      md.center.SetZero();  // the body origin is the polygon's centroid
+      md.I = static_cast<float>(scene.engine_inertia(i));
+      body->SetMassData(&md);
+    }
+    index_[body] = static_cast<std::int32_t>(i);
+    bodies_.push_back(body);
+  }
+  state_.resize(bodies_.size());
+  publish();
+}
+
+EngineInfo Box2dEngine::info() const {
+  EngineInfo i;
+  i.name = "box2d";
+  i.version = std::to_string(b2_version.major) + "." + std::to_string(b2_version.minor) + "." +
+              std::to_string(b2_version.revision);
+  i.settings = {{"velocity_iterations", std::to_string(settings_.velocity_iterations)},
+                {"position_iterations", std::to_string(settings_.position_iterations)},
+                {"polygon_radius", std::to_string(settings_.polygon_radius)},
+                {"restitution_threshold", "0"},
+                {"sleeping", "off"},
+                {"continuous_collision", "off"}};
+  i.limitations = {"single precision (coordinates relative to the scene's mean centroid)",
+                   "friction of a pair mixes as sqrt(mu_a mu_b) (equal here: one mu per scene)",
+                   "position correction by Box2D's own nonlinear Gauss-Seidel (linear slop 0.005 m)"};
+  return i;
+}
+
+void Box2dEngine::PreSolve(b2Contact* contact, const b2Manifold*) {
+  // Normal approach velocity of each point before the step (the solve has not run yet).
+  b2WorldManifold wm;
+  contact->GetWorldManifold(&wm);
+  const b2Body* a = contact->GetFixtureA()->GetBody();
+  const b2Body* b = contact->GetFixtureB()->GetBody();
+  std::array<double, 2> u{0.0, 0.0};
+  for (int k = 0; k < contact->GetManifold()->pointCount; ++k)
+    u[k] = dot(point_velocity(b, wm.points[k]) - point_velocity(a, wm.points[k]), Vec2{wm.normal.x, wm.normal.y});
+  approach_[contact] = u;
+}
+
+void Box2dEngine::PostSolve(b2Contact* contact, const b2ContactImpulse* impulse) {
+  b2WorldManifold wm;
+  contact->GetWorldManifold(&wm);
+  const std::int32_t ia = index_.at(contact->GetFixtureA()->GetBody());
+  const std::int32_t ib = index_.at(contact->GetFixtureB()->GetBody());
+  const Vec2 n{wm.normal.x, wm.normal.y};  // from A to B
+  const Vec2 t{n.y, -n.x};                 // Box2D's tangent: b2Cross(normal, 1)
+  const auto found = approach_.find(contact);
+  for (int k = 0; k < contact->GetManifold()->pointCount; ++k) {
+    const double pn = impulse->normalImpulses[k], pt = impulse->tangentImpulses[k];
+    if (pn == 0.0 && pt == 0.0) continue;
+    // floedem's convention: a < b, normal from a to b, impulses on b.
+    const bool flip = ia > ib;
+    const Vec2 normal = flip ? -n : n;
+    const Vec2 on_b = (flip ? -1.0 : 1.0) * (pn * n + pt * t);
+    ContactRecord r;
+    r.body_a = flip ? ib : ia;
+    r.body_b = flip ? ia : ib;
+    r.point = origin_ + Vec2{wm.points[k].x, wm.points[k].y};
+    r.normal = normal;
+    r.normal_impulse = dot(on_b, normal);
+    r.tangent_impulse = dot(on_b, perp(normal));
+    r.approach_velocity = found != approach_.end() ? found->second[k] : 0.0;
+    r.separation = wm.separations[k];
+    r.kind = r.approach_velocity < -threshold_ ? ContactKind::collision : ContactKind::resting;
+    records_.push_back(r);
+  }
+}
+
+void Box2dEngine::step(const Loads* loads) {
+  records_.clear();
+  approach_.clear();
+  if (loads) {
+    for (const PrescribedMotion& p : loads->prescribed) {
+      bodies_[p.body]->SetLinearVelocity(b2Vec2(static_cast<float>(p.velocity.x), static_cast<float>(p.velocity.y)));
+      bodies_[p.body]->SetAngularVelocity(static_cast<float>(p.angular_velocity));
+    }
+    if (loads->any)
+      for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        if (bodies_[i]->GetType() != b2_dynamicBody) continue;
+        bodies_[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(loads->force[i].x), static_cast<float>(loads->force[i].y)), true);
+        bodies_[i]->ApplyTorque(static_cast<float>(loads->torque[i]), true);
+      }
+  }
+  world_.Step(static_cast<float>(dt_), settings_.velocity_iterations, settings_.position_iterations);
+  publish();
+}
+
+void Box2dEngine::publish() {
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const b2Body* b = bodies_[i];
+    state_.position[i] = origin_ + Vec2{b->GetPosition().x, b->GetPosition().y};
+    state_.angle[i] = b->GetAngle();
+    state_.velocity[i] = {b->GetLinearVelocity().x, b->GetLinearVelocity().y};
+    state_.angular_velocity[i] = b->GetAngularVelocity();
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Engine> make_box2d_engine(const Scene& scene) { return std::make_unique<Box2dEngine>(scene); }
+
+}  // namespace floedem
