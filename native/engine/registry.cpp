@@ -2,6 +2,7 @@
 
 #include "scene/input_error.hpp"
 #include "reference/box2d/box2d_engine.hpp"
+#include "reference/bullet/bullet_engine.hpp"
 #include "solver/native_engine.hpp"
 
 namespace floedem {
@@ -12,6 +13,8 @@ const std::vector<EngineEntry>& engines() {
        make_native_engine},
       {"box2d", "Box2D 2.4 (reference): the polygons themselves, restitution threshold 0, polygon radius 0",
        make_box2d_engine},
+      {"bullet", "Bullet 3 double (reference): extruded prisms held in the plane, split impulse, max/min combine",
+       make_bullet_engine},
   };
   return table;
 }

@@ -1,0 +1,251 @@
+// Bullet 3.24 (double precision) as a reference engine: each convex part an extruded prism
+// (btConvexHullShape), held in the plane by linear factor (1, 1, 0) and angular factor
+// (0, 0, 1), mass and planar inertia set to floedem's values.
+// Settings that matter (measured in shared/notes/reference-engines.md; Bullet's defaults give
+// e = 0.22, 0.62, or 0 instead of 0.3 on the same impact):
+//  - restitution of a pair = max, friction = min (the default multiplies both: mu 0.3 -> 0.09);
+//  - split impulse on for any penetration (m_splitImpulsePenetrationThreshold = 0), so that
+//    the penetration push does not add to the bounce;
+//  - contact processing threshold 0 and a restitution velocity threshold of the scene's
+//    collision threshold (default 0.2 m/s kills drift-speed bounces);
+//  - hull points moved inward by the collision margin (the margin lies outside the hull:
+//    bodies would start overlapped);
+//  - stepSimulation(dt, 0): one step of exactly dt (the default is fixed 1/60 s substeps);
+//  - the prism is far taller than any overlap can get: otherwise a deep sideways overlap picks
+//    a normal along z, which the plane constraint absorbs, and floes pass through each other;
+//  - only points with distance <= 0 are read: getAppliedImpulse() keeps stale values on
+//    points that were not solved this step.
+#include "reference/bullet/bullet_engine.hpp"
+
+#include <btBulletDynamicsCommon.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "geometry/polygon.hpp"
+#include "scenario/table_reader.hpp"
+
+namespace floedem {
+
+namespace {
+
+struct BulletSettings {
+  int iterations = 50;
+  double margin = 0.01;  ///< m, collision margin
+};
+
+BulletSettings read_settings(const Scene& scene) {
+  BulletSettings s;
+  const auto it = scene.engine_settings.find("bullet");
+  if (it == scene.engine_settings.end()) return s;
+  TableReader r(it->second, scene.source_path, "engine.bullet");
+  s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
+  s.margin = r.real("margin", s.margin, Range::positive());
+  r.reject_unknown();
+  return s;
+}
+
+btScalar combined_restitution(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::max(a->getRestitution(), b->getRestitution());
+}
+btScalar combined_friction(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::min(a->getFriction(), b->getFriction());
+}
+
+class BulletEngine final : public Engine {
+ public:
+  explicit BulletEngine(const Scene& scene);
+  ~BulletEngine() override;
+  void step(const Loads* loads) override;
+  const BodyStates& state() const override { return state_; }
+  std::span<const ContactRecord> contacts() const override { return records_; }
+  EngineInfo info() const override;
+
+ private:
+  void publish();
+  void collect_contacts();
+
+  BulletSettings settings_;
+  double dt_;
+  double threshold_;
+  double height_ = 0.0;  // prism height, m
+  btDefaultCollisionConfiguration configuration_;
+  btCollisionDispatcher dispatcher_{&configuration_};
+  btDbvtBroadphase broadphase_;
+  btSequentialImpulseConstraintSolver solver_;
+  btDiscreteDynamicsWorld world_{&dispatcher_, &broadphase_, &solver_, &configuration_};
+  std::vector<std::unique_ptr<btCollisionShape>> shapes_;
+  std::vector<std::unique_ptr<btDefaultMotionState>> motion_states_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+  std::vector<std::uint8_t> kinematic_;
+  BodyStates state_, before_;
+  std::vector<ContactRecord> records_;
+  double max_out_of_plane_ = 0.0;  // m and rad, over the run
+};
+
+BulletEngine::BulletEngine(const Scene& scene)
+    : settings_(read_settings(scene)), dt_(scene.run.dt), threshold_(scene.contact.collision_threshold) {
+  gCalculateCombinedRestitutionCallback = combined_restitution;
+  gCalculateCombinedFrictionCallback = combined_friction;
+  world_.setGravity(btVector3(0, 0, 0));
+  btContactSolverInfo& info = world_.getSolverInfo();
+  info.m_numIterations = settings_.iterations;
+  info.m_splitImpulse = 1;
+  info.m_splitImpulsePenetrationThreshold = 0;
+  info.m_restitutionVelocityThreshold = threshold_;
+
+  // Taller than any overlap can get: four times the largest body.
+  for (const BodySpec& b : scene.bodies) {
+    const Aabb box = bounds_of(b.local_polygon);
+    height_ = std::max(height_, 4.0 * length(box.hi - box.lo));
+  }
+  const double m = settings_.margin;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const BodySpec& spec = scene.bodies[i];
+    std::vector<btCollisionShape*> hulls;
+    for (const auto& part : spec.local_parts) {
+      auto hull = std::make_unique<btConvexHullShape>();
+      for (const Vec2 p : inset_convex(part, m))
+        for (const double z : {-0.5 * height_ + m, 0.5 * height_ - m}) hull->addPoint(btVector3(p.x, p.y, z), false);
+      hull->recalcLocalAabb();
+      hull->setMargin(m);
+      hulls.push_back(hull.get());
+      shapes_.push_back(std::move(hull));
+    }
+    btCollisionShape* shape = hulls.front();
+    if (hulls.size() > 1) {
+      auto compound = std::make_unique<btCompoundShape>();
+      btTransform identity;
+      identity.setIdentity();
+      for (btCollisionShape* h : hulls) compound->addChildShape(identity, h);
+      shape = compound.get();
+      shapes_.push_back(std::move(compound));
+    }
+    btTransform start;
+    start.setIdentity();
+    start.setOrigin(btVector3(spec.centroid.x, spec.centroid.y, 0));
+    motion_states_.push_back(std::make_unique<btDefaultMotionState>(start));
+    const bool dynamic = !spec.fixed && !spec.prescribed;
+    const double mass = dynamic ? scene.engine_mass(i) : 0.0;
+    const double izz = scene.engine_inertia(i);
+    // Only I_zz matters: the angular factor (0, 0, 1) removes the other axes.
+    btRigidBody::btRigidBodyConstructionInfo ci(mass, motion_states_.back().get(), shape,
+                                                dynamic ? btVector3(izz, izz, izz) : btVector3(0, 0, 0));
+    ci.m_restitution = scene.contact.restitution;
+    ci.m_friction = scene.contact.friction;
+    ci.m_linearDamping = 0;
+    ci.m_angularDamping = 0;
+    auto body = std::make_unique<btRigidBody>(ci);
+    body->setLinearFactor(btVector3(1, 1, 0));
+    body->setAngularFactor(btVector3(0, 0, 1));
+    body->setLinearVelocity(btVector3(spec.velocity.x, spec.velocity.y, 0));
+    body->setAngularVelocity(btVector3(0, 0, spec.angular_velocity));
+    body->setActivationState(DISABLE_DEACTIVATION);
+    body->setContactProcessingThreshold(0);
+    body->setUserIndex(static_cast<int>(i));
+    if (spec.prescribed) body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+    kinematic_.push_back(spec.prescribed ? 1 : 0);
+    world_.addRigidBody(body.get());
+    bodies_.push_back(std::move(body));
+  }
+  state_.resize(bodies_.size());
+  publish();
+}
+
+BulletEngine::~BulletEngine() {
+  for (auto& b : bodies_) world_.removeRigidBody(b.get());
+}
+
+EngineInfo BulletEngine::info() const {
+  EngineInfo i;
+  i.name = "bullet";
+  i.version = std::to_string(btGetVersion() / 100) + "." + std::to_string(btGetVersion() % 100) + " (double)";
+  i.settings = {{"iterations", std::to_string(settings_.iterations)},
+                {"margin", std::to_string(settings_.margin)},
+                {"prism_height", std::to_string(height_)},
+                {"split_impulse", "on, threshold 0"},
+                {"restitution_velocity_threshold", std::to_string(threshold_)},
+                {"combine", "restitution max, friction min"},
+                {"max_out_of_plane", std::to_string(max_out_of_plane_)}};
+  i.limitations = {"bodies are prisms held in the plane by linear and angular factors",
+                   "up to 4 contact points per pair, top and bottom of the prism (compare impulses summed per pair)"};
+  return i;
+}
+
+void BulletEngine::step(const Loads* loads) {
+  before_ = state_;
+  if (loads) {
+    for (const PrescribedMotion& p : loads->prescribed) {
+      // Kinematic bodies: Bullet takes their velocity from the motion state's change.
+      btRigidBody* b = bodies_[p.body].get();
+      btTransform t = b->getWorldTransform();
+      t.setOrigin(t.getOrigin() + btVector3(p.velocity.x, p.velocity.y, 0) * dt_);
+      b->getMotionState()->setWorldTransform(t);
+    }
+    if (loads->any)
+      for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        if (bodies_[i]->getInvMass() == 0) continue;
+        bodies_[i]->applyCentralForce(btVector3(loads->force[i].x, loads->force[i].y, 0));
+        bodies_[i]->applyTorque(btVector3(0, 0, loads->torque[i]));
+      }
+  }
+  world_.stepSimulation(dt_, 0);
+  publish();
+  collect_contacts();
+}
+
+void BulletEngine::collect_contacts() {
+  records_.clear();
+  const int manifolds = dispatcher_.getNumManifolds();
+  for (int k = 0; k < manifolds; ++k) {
+    const btPersistentManifold* pm = dispatcher_.getManifoldByIndexInternal(k);
+    const int i0 = pm->getBody0()->getUserIndex(), i1 = pm->getBody1()->getUserIndex();
+    for (int j = 0; j < pm->getNumContacts(); ++j) {
+      const btManifoldPoint& pt = pm->getContactPoint(j);
+      if (pt.getDistance() > 0) continue;  // not solved this step: its impulse is stale
+      // Bullet pushes body 0 along m_normalWorldOnB.
+      const btVector3 on0 = pt.m_appliedImpulse * pt.m_normalWorldOnB + pt.m_appliedImpulseLateral1 * pt.m_lateralFrictionDir1 +
+                            pt.m_appliedImpulseLateral2 * pt.m_lateralFrictionDir2;
+      if (on0.length2() == 0) continue;
+      const bool flip = i0 > i1;  // floedem: a < b, normal from a to b, impulse on b
+      const Vec2 n0{pt.m_normalWorldOnB.x(), pt.m_normalWorldOnB.y()};
+      const Vec2 normal = normalized(flip ? n0 : -n0);  // from body 0 towards body 1 is -n0
+      const Vec2 on_b = flip ? Vec2{on0.x(), on0.y()} : Vec2{-on0.x(), -on0.y()};
+      ContactRecord r;
+      r.body_a = flip ? i1 : i0;
+      r.body_b = flip ? i0 : i1;
+      const btVector3 p = 0.5 * (pt.getPositionWorldOnA() + pt.getPositionWorldOnB());
+      r.point = {p.x(), p.y()};
+      r.normal = normal;
+      r.normal_impulse = dot(on_b, normal);
+      r.tangent_impulse = dot(on_b, perp(normal));
+      r.separation = pt.getDistance();
+      const auto pv = [&](int i) {
+        return before_.velocity[i] + cross(before_.angular_velocity[i], r.point - before_.position[i]);
+      };
+      r.approach_velocity = dot(pv(r.body_b) - pv(r.body_a), normal);
+      r.kind = r.approach_velocity < -threshold_ ? ContactKind::collision : ContactKind::resting;
+      records_.push_back(r);
+    }
+  }
+}
+
+void BulletEngine::publish() {
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const btRigidBody* b = bodies_[i].get();
+    const btTransform& t = b->getWorldTransform();
+    btScalar yaw, pitch, roll;
+    t.getBasis().getEulerZYX(yaw, pitch, roll);
+    state_.position[i] = {t.getOrigin().x(), t.getOrigin().y()};
+    state_.angle[i] = yaw;
+    state_.velocity[i] = {b->getLinearVelocity().x(), b->getLinearVelocity().y()};
+    state_.angular_velocity[i] = b->getAngularVelocity().z();
+    max_out_of_plane_ = std::max({max_out_of_plane_, std::abs(t.getOrigin().z()), std::abs(pitch), std::abs(roll)});
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Engine> make_bullet_engine(const Scene& scene) { return std::make_unique<BulletEngine>(scene); }
+
+}  // namespace floedem
