@@ -15,6 +15,7 @@
 #include "solver/broad_phase.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/narrow_phase.hpp"
+#include "solver/part_set.hpp"
 #include "solver/native_settings.hpp"
 
 namespace floedem {
@@ -47,12 +48,7 @@ class NativeEngine final : public Engine {
   // Hot: touched every step.
   BodyArrays bodies_;
   std::vector<std::uint8_t> moves_;        // 0 for fixed bodies
-  std::vector<std::int32_t> part_body_;
-  std::vector<std::uint8_t> part_fixed_;
-  std::vector<std::int32_t> part_first_;   // first vertex of part k; part k has part_first_[k+1]-part_first_[k]
-  std::vector<Vec2> local_vertices_, local_normals_;
-  std::vector<Vec2> world_vertices_, world_normals_;
-  std::vector<double> part_radius_;        // largest distance of a vertex from the body's centroid
+  PartSet parts_;
   std::vector<double> linear_reach_;       // per body: dt |v| this step
   std::vector<double> angular_reach_;      // per body: dt |w| this step
   std::vector<double> part_reach_;         // per part: how far any of its points can move this step
@@ -71,7 +67,8 @@ class NativeEngine final : public Engine {
 NativeEngine::NativeEngine(const Scene& scene)
     : settings_(read_native_settings(scene)),
       contact_(scene.contact),
-      dt_(scene.run.dt) {
+      dt_(scene.run.dt),
+      parts_(scene) {
   const std::size_t n = scene.bodies.size();
   bodies_.position.resize(n);
   bodies_.angle.assign(n, 0.0);
@@ -81,7 +78,6 @@ NativeEngine::NativeEngine(const Scene& scene)
   bodies_.inv_mass.resize(n);
   bodies_.inv_inertia.resize(n);
   moves_.resize(n);
-  part_first_.push_back(0);
   for (std::size_t i = 0; i < n; ++i) {
     const BodySpec& b = scene.bodies[i];
     bodies_.position[i] = b.centroid;
@@ -92,27 +88,11 @@ NativeEngine::NativeEngine(const Scene& scene)
     bodies_.inv_mass[i] = infinite ? 0.0 : 1.0 / scene.engine_mass(i);
     bodies_.inv_inertia[i] = infinite ? 0.0 : 1.0 / scene.engine_inertia(i);
     moves_[i] = b.fixed ? 0 : 1;
-    for (const auto& part : b.local_parts) {
-      double radius = 0.0;
-      const std::size_t m = part.size();
-      for (std::size_t k = 0; k < m; ++k) {
-        local_vertices_.push_back(part[k]);
-        const Vec2 e = part[(k + 1) % m] - part[k];
-        local_normals_.push_back(normalized(Vec2{e.y, -e.x}));
-        radius = std::max(radius, length(part[k]));
-      }
-      part_body_.push_back(static_cast<std::int32_t>(i));
-      part_fixed_.push_back(b.fixed || b.prescribed ? 1 : 0);
-      part_first_.push_back(static_cast<std::int32_t>(local_vertices_.size()));
-      part_radius_.push_back(radius);
-    }
   }
-  world_vertices_.resize(local_vertices_.size());
-  world_normals_.resize(local_normals_.size());
-  part_boxes_.resize(part_body_.size());
+  part_boxes_.resize(parts_.size());
   linear_reach_.resize(n);
   angular_reach_.resize(n);
-  part_reach_.resize(part_body_.size());
+  part_reach_.resize(parts_.size());
   publish_state();
 }
 
@@ -166,36 +146,20 @@ void NativeEngine::find_pairs(const Loads* loads) {
     linear_reach_[i] = dt_ * speed;
     angular_reach_[i] = dt_ * spin;
   }
-  const std::size_t np = part_body_.size();
+  parts_.place(bodies_.position, bodies_.rotation);
+  const std::size_t np = parts_.size();
   for (std::size_t k = 0; k < np; ++k) {
-    const std::int32_t b = part_body_[k];
-    const Transform x{bodies_.position[b], bodies_.rotation[b]};
-    Aabb box{world_vertices_[0], world_vertices_[0]};
-    for (std::int32_t v = part_first_[k]; v < part_first_[k + 1]; ++v) {
-      const Vec2 p = x.apply(local_vertices_[v]);
-      world_vertices_[v] = p;
-      world_normals_[v] = x.q.apply(local_normals_[v]);
-      if (v == part_first_[k]) box = Aabb{p, p};
-      box.lo.x = std::min(box.lo.x, p.x);
-      box.lo.y = std::min(box.lo.y, p.y);
-      box.hi.x = std::max(box.hi.x, p.x);
-      box.hi.y = std::max(box.hi.y, p.y);
-    }
-    part_reach_[k] = linear_reach_[b] + angular_reach_[b] * part_radius_[k];
+    const std::int32_t b = parts_.body()[k];
+    part_reach_[k] = linear_reach_[b] + angular_reach_[b] * parts_.radius(static_cast<std::int32_t>(k));
     const double fat = part_reach_[k] + 0.5 * settings_.allowed_penetration;
-    box.lo -= Vec2{fat, fat};
-    box.hi += Vec2{fat, fat};
-    part_boxes_[k] = box;
+    part_boxes_[k] = {parts_.boxes()[k].lo - Vec2{fat, fat}, parts_.boxes()[k].hi + Vec2{fat, fat}};
   }
-  broad_phase_.find_pairs(part_boxes_, part_body_, part_fixed_, pairs_);
+  broad_phase_.find_pairs(part_boxes_, parts_.body(), parts_.immovable(), pairs_);
 }
 
 PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
-  const std::int32_t first = part_first_[k];
-  const std::int32_t b = part_body_[k];
-  return PartGeometry{ConvexView{&world_vertices_[first], &world_normals_[first], part_first_[k + 1] - first},
-                      &local_vertices_[first], &local_normals_[first],
-                      Transform{bodies_.position[b], bodies_.rotation[b]}};
+  const std::int32_t b = parts_.body()[k];
+  return parts_.geometry(k, bodies_.position[b], bodies_.rotation[b]);
 }
 
 void NativeEngine::build_manifolds() {
@@ -207,8 +171,8 @@ void NativeEngine::build_manifolds() {
     Manifold m;
     m.part_a = pair.a;
     m.part_b = pair.b;
-    m.body_a = part_body_[pair.a];
-    m.body_b = part_body_[pair.b];
+    m.body_a = parts_.body()[pair.a];
+    m.body_b = parts_.body()[pair.b];
     m.friction = contact_.friction;
     m.restitution = contact_.restitution;
     const double margin = part_reach_[pair.a] + part_reach_[pair.b] + settings_.allowed_penetration;

@@ -1,0 +1,57 @@
+#include "solver/part_set.hpp"
+
+#include <algorithm>
+
+namespace floedem {
+
+PartSet::PartSet(const Scene& scene) {
+  first_.push_back(0);
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const BodySpec& b = scene.bodies[i];
+    for (const auto& part : b.local_parts) {
+      double r = 0.0;
+      const std::size_t m = part.size();
+      for (std::size_t k = 0; k < m; ++k) {
+        local_vertices_.push_back(part[k]);
+        const Vec2 e = part[(k + 1) % m] - part[k];
+        local_normals_.push_back(normalized(Vec2{e.y, -e.x}));
+        r = std::max(r, length(part[k]));
+      }
+      body_.push_back(static_cast<std::int32_t>(i));
+      immovable_.push_back(b.fixed || b.prescribed ? 1 : 0);
+      first_.push_back(static_cast<std::int32_t>(local_vertices_.size()));
+      radius_.push_back(r);
+    }
+  }
+  world_vertices_.resize(local_vertices_.size());
+  world_normals_.resize(local_normals_.size());
+  boxes_.resize(body_.size());
+}
+
+void PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotation) {
+  const std::size_t np = body_.size();
+  for (std::size_t k = 0; k < np; ++k) {
+    const std::int32_t b = body_[k];
+    const Transform x{position[b], rotation[b]};
+    const Vec2 first = x.apply(local_vertices_[first_[k]]);
+    Aabb box{first, first};
+    for (std::int32_t v = first_[k]; v < first_[k + 1]; ++v) {
+      const Vec2 p = x.apply(local_vertices_[v]);
+      world_vertices_[v] = p;
+      world_normals_[v] = x.q.apply(local_normals_[v]);
+      box.lo.x = std::min(box.lo.x, p.x);
+      box.lo.y = std::min(box.lo.y, p.y);
+      box.hi.x = std::max(box.hi.x, p.x);
+      box.hi.y = std::max(box.hi.y, p.y);
+    }
+    boxes_[k] = box;
+  }
+}
+
+PartGeometry PartSet::geometry(std::int32_t k, Vec2 position, Rot rotation) const {
+  const std::int32_t first = first_[k];
+  return PartGeometry{ConvexView{&world_vertices_[first], &world_normals_[first], first_[k + 1] - first},
+                      &local_vertices_[first], &local_normals_[first], Transform{position, rotation}};
+}
+
+}  // namespace floedem

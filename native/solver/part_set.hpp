@@ -1,0 +1,40 @@
+#pragma once
+// The convex parts of every body, in their body's frame and placed in the world each step:
+// what the broad and narrow phases read. Shared by the native engine and by reference
+// engines that take floedem's 2-D contact geometry (ODE).
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "scene/scene.hpp"
+#include "solver/narrow_phase.hpp"
+
+namespace floedem {
+
+class PartSet {
+ public:
+  explicit PartSet(const Scene& scene);
+  std::size_t size() const { return body_.size(); }
+
+  /// World vertices, normals and tight bounds of every part for the bodies' placements.
+  void place(std::span<const Vec2> position, std::span<const Rot> rotation);
+
+  PartGeometry geometry(std::int32_t part, Vec2 position, Rot rotation) const;
+  std::span<const std::int32_t> body() const { return body_; }
+  /// Non-zero for parts of bodies of infinite mass in contacts (fixed or prescribed).
+  std::span<const std::uint8_t> immovable() const { return immovable_; }
+  /// Largest distance of a vertex of the part from its body's centroid (m).
+  double radius(std::int32_t part) const { return radius_[part]; }
+  std::span<const Aabb> boxes() const { return boxes_; }
+
+ private:
+  std::vector<std::int32_t> body_;
+  std::vector<std::uint8_t> immovable_;
+  std::vector<std::int32_t> first_;  // first vertex of part k; part k ends at first_[k + 1]
+  std::vector<Vec2> local_vertices_, local_normals_;
+  std::vector<Vec2> world_vertices_, world_normals_;
+  std::vector<double> radius_;
+  std::vector<Aabb> boxes_;
+};
+
+}  // namespace floedem
