@@ -3,6 +3,7 @@
 #include "scene/input_error.hpp"
 #include "reference/box2d/box2d_engine.hpp"
 #include "reference/bullet/bullet_engine.hpp"
+#include "reference/ode/ode_engine.hpp"
 #include "solver/native_engine.hpp"
 
 namespace floedem {
@@ -15,6 +16,8 @@ const std::vector<EngineEntry>& engines() {
        make_box2d_engine},
       {"bullet", "Bullet 3 double (reference): extruded prisms held in the plane, split impulse, max/min combine",
        make_bullet_engine},
+      {"ode", "ODE 0.16 double (reference): plane-2D joints, QuickStep, contact points from floedem's 2-D narrow phase",
+       make_ode_engine},
   };
   return table;
 }

@@ -1,0 +1,280 @@
+// ODE 0.16 (double precision) as a reference engine: bodies held in the plane by a plane-2D
+// joint, mass and planar inertia set to floedem's values, contacts solved by ODE's QuickStep.
+// Contact points come from floedem's 2-D narrow phase (the prisms' side faces, projected):
+// ODE's own convex-convex collider returns one point per step on a top corner, which gave
+// e = 0.19 to 0.22 instead of 0.3 with spurious spin (shared/notes/reference-engines.md), so
+// only the contact *solution* is ODE's here; the geometry is the same as native's.
+// Settings that matter (measured in the notes):
+//  - QuickStep: dWorldStep caps friction at mu times the frictionless normal impulse and never
+//    updates the cap, wrong whenever friction slides; it also fails on packs;
+//  - dContactApprox1: otherwise mu is a force limit in newtons;
+//  - friction along the in-plane tangent only (fdir1, mu2 = 0): the second direction is z;
+//  - CFM tiny: the CFM error is about CFM / (dt W), W the effective inverse mass;
+//  - the ERP correction velocity capped: ODE takes the larger of the bounce and the
+//    correction, so an uncapped correction inflates restitution (erp 0.8 gave e = 0.5);
+//  - the plane-2D joint drifts unless each step resets the rotation's x/y parts and the
+//    angular velocity's x/y (tilt 3e-5 rad otherwise).
+#include "reference/ode/ode_engine.hpp"
+
+#include <ode/ode.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include "scenario/table_reader.hpp"
+#include "solver/broad_phase.hpp"
+#include "solver/part_set.hpp"
+
+namespace floedem {
+
+namespace {
+
+struct OdeSettings {
+  int iterations = 50;
+  double cfm = 1e-16;
+  double erp = 0.2;
+  double max_correcting_velocity = 0.01;  ///< m/s
+};
+
+OdeSettings read_settings(const Scene& scene) {
+  OdeSettings s;
+  const auto it = scene.engine_settings.find("ode");
+  if (it == scene.engine_settings.end()) return s;
+  TableReader r(it->second, scene.source_path, "engine.ode");
+  s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
+  s.cfm = r.real("cfm", s.cfm, Range::non_negative());
+  s.erp = r.real("erp", s.erp, Range::closed(0.0, 1.0));
+  s.max_correcting_velocity = r.real("max_correcting_velocity", s.max_correcting_velocity, Range::non_negative());
+  r.reject_unknown();
+  return s;
+}
+
+class OdeEngine final : public Engine {
+ public:
+  explicit OdeEngine(const Scene& scene);
+  ~OdeEngine() override;
+  void step(const Loads* loads) override;
+  const BodyStates& state() const override { return state_; }
+  std::span<const ContactRecord> contacts() const override { return records_; }
+  EngineInfo info() const override;
+
+ private:
+  struct Pending {
+    dJointID joint;
+    ContactRecord record;
+    bool b_is_body1;  // else a is body 1 (b is static)
+  };
+  void publish();
+  void keep_in_plane();
+
+  OdeSettings settings_;
+  double dt_;
+  ContactSettings contact_;
+  dWorldID world_ = nullptr;
+  dJointGroupID contact_group_ = nullptr;
+  std::vector<dBodyID> bodies_;  // nullptr for fixed bodies
+  std::vector<Vec2> fixed_position_;
+  PartSet parts_;
+  BroadPhase broad_phase_;
+  std::vector<PartPair> pairs_;
+  std::vector<Rot> rotation_;
+  std::vector<dJointFeedback> feedback_;
+  std::vector<Pending> pending_;
+  std::vector<ContactRecord> records_;
+  BodyStates state_;
+  double max_out_of_plane_ = 0.0;
+};
+
+OdeEngine::OdeEngine(const Scene& scene)
+    : settings_(read_settings(scene)), dt_(scene.run.dt), contact_(scene.contact), parts_(scene) {
+  static std::once_flag init;
+  std::call_once(init, [] { dInitODE2(0); });
+  world_ = dWorldCreate();
+  dWorldSetGravity(world_, 0, 0, 0);
+  dWorldSetCFM(world_, settings_.cfm);
+  dWorldSetERP(world_, settings_.erp);
+  dWorldSetContactMaxCorrectingVel(world_, settings_.max_correcting_velocity);
+  dWorldSetQuickStepNumIterations(world_, settings_.iterations);
+  dWorldSetAutoDisableFlag(world_, 0);
+  contact_group_ = dJointGroupCreate(0);
+  const std::size_t n = scene.bodies.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodySpec& b = scene.bodies[i];
+    fixed_position_.push_back(b.centroid);
+    if (b.fixed) {
+      bodies_.push_back(nullptr);
+      continue;
+    }
+    dBodyID body = dBodyCreate(world_);
+    dBodySetPosition(body, b.centroid.x, b.centroid.y, 0.0);
+    dBodySetLinearVel(body, b.velocity.x, b.velocity.y, 0.0);
+    dBodySetAngularVel(body, 0.0, 0.0, b.angular_velocity);
+    if (b.prescribed) {
+      dBodySetKinematic(body);
+    } else {
+      dMass m;
+      const double izz = scene.engine_inertia(i);
+      // Only I_zz matters in the plane; the others are set equal to keep the tensor valid.
+      dMassSetParameters(&m, scene.engine_mass(i), 0, 0, 0, izz, izz, izz, 0, 0, 0);
+      dBodySetMass(body, &m);
+      dJointID plane = dJointCreatePlane2D(world_, 0);
+      dJointAttach(plane, body, nullptr);
+    }
+    bodies_.push_back(body);
+  }
+  rotation_.resize(n);
+  state_.resize(n);
+  publish();
+}
+
+OdeEngine::~OdeEngine() {
+  dJointGroupDestroy(contact_group_);
+  dWorldDestroy(world_);
+}
+
+EngineInfo OdeEngine::info() const {
+  EngineInfo i;
+  i.name = "ode";
+  i.version = "0.16 (double)";
+  i.settings = {{"iterations", std::to_string(settings_.iterations)},
+                {"step", "dWorldQuickStep"},
+                {"cfm", std::to_string(settings_.cfm)},
+                {"erp", std::to_string(settings_.erp)},
+                {"max_correcting_velocity", std::to_string(settings_.max_correcting_velocity)},
+                {"friction", "dContactApprox1, in-plane tangent only"},
+                {"contact_geometry", "floedem 2-D narrow phase"},
+                {"max_out_of_plane", std::to_string(max_out_of_plane_)}};
+  i.limitations = {"contact points from floedem's 2-D narrow phase, not ODE's colliders (one point per step for convex prisms)",
+                   "contacts found only once bodies touch (no speculative contact): impacts resolve after up to v dt of overlap"};
+  return i;
+}
+
+void OdeEngine::step(const Loads* loads) {
+  // Contact points at the start of the step, from floedem's narrow phase.
+  for (std::size_t i = 0; i < bodies_.size(); ++i) rotation_[i] = Rot::from_angle(state_.angle[i]);
+  parts_.place(state_.position, rotation_);
+  broad_phase_.find_pairs(parts_.boxes(), parts_.body(), parts_.immovable(), pairs_);
+  pending_.clear();
+  feedback_.resize(0);
+  feedback_.reserve(2 * pairs_.size());
+  for (const PartPair& pair : pairs_) {
+    const std::int32_t a = parts_.body()[pair.a], b = parts_.body()[pair.b];
+    Manifold m;
+    const double touch = 1e-9 * (parts_.radius(pair.a) + parts_.radius(pair.b));  // round-off of touching
+    collide(parts_.geometry(pair.a, state_.position[a], rotation_[a]), parts_.geometry(pair.b, state_.position[b], rotation_[b]),
+            touch, 1e-6, m);
+    for (int k = 0; k < m.point_count; ++k) {
+      const ManifoldPoint& p = m.points[k];
+      const bool b_is_body1 = bodies_[b] != nullptr;
+      dContact c{};
+      c.surface.mode = dContactBounce | dContactSoftCFM | dContactApprox1 | dContactFDir1 | dContactMu2;
+      c.surface.mu = contact_.friction;
+      c.surface.mu2 = 0.0;
+      c.surface.bounce = contact_.restitution;
+      c.surface.bounce_vel = contact_.collision_threshold;
+      c.surface.soft_cfm = settings_.cfm;
+      // ODE: moving body 1 along the normal by depth separates the bodies.
+      const Vec2 normal = b_is_body1 ? m.normal : -m.normal;
+      c.geom.pos[0] = p.point.x;
+      c.geom.pos[1] = p.point.y;
+      c.geom.pos[2] = 0.0;
+      c.geom.normal[0] = normal.x;
+      c.geom.normal[1] = normal.y;
+      c.geom.normal[2] = 0.0;
+      c.geom.depth = std::max(0.0, -p.separation);
+      const Vec2 t = perp(normal);
+      c.fdir1[0] = t.x;
+      c.fdir1[1] = t.y;
+      c.fdir1[2] = 0.0;
+      dJointID j = dJointCreateContact(world_, contact_group_, &c);
+      if (b_is_body1)
+        dJointAttach(j, bodies_[b], bodies_[a]);
+      else
+        dJointAttach(j, bodies_[a], nullptr);
+      ContactRecord r;
+      r.body_a = a;
+      r.body_b = b;
+      r.point = p.point;
+      r.normal = m.normal;
+      r.separation = p.separation;
+      const auto pv = [&](std::int32_t i) { return state_.velocity[i] + cross(state_.angular_velocity[i], p.point - state_.position[i]); };
+      r.approach_velocity = dot(pv(b) - pv(a), m.normal);
+      r.kind = r.approach_velocity < -contact_.collision_threshold ? ContactKind::collision : ContactKind::resting;
+      pending_.push_back({j, r, b_is_body1});
+    }
+  }
+  for (Pending& p : pending_) {
+    feedback_.push_back(dJointFeedback{});
+    dJointSetFeedback(p.joint, &feedback_.back());
+  }
+  if (loads) {
+    for (const PrescribedMotion& p : loads->prescribed) {
+      dBodySetLinearVel(bodies_[p.body], p.velocity.x, p.velocity.y, 0.0);
+      dBodySetAngularVel(bodies_[p.body], 0.0, 0.0, p.angular_velocity);
+    }
+    if (loads->any)
+      for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        if (!bodies_[i] || dBodyIsKinematic(bodies_[i])) continue;
+        dBodyAddForce(bodies_[i], loads->force[i].x, loads->force[i].y, 0.0);
+        dBodyAddTorque(bodies_[i], 0.0, 0.0, loads->torque[i]);
+      }
+  }
+  dWorldQuickStep(world_, dt_);
+  keep_in_plane();
+  // Impulses: the joints' forces on body 1 times dt.
+  records_.clear();
+  for (std::size_t k = 0; k < pending_.size(); ++k) {
+    const dJointFeedback& f = feedback_[k];
+    ContactRecord r = pending_[k].record;
+    const Vec2 on_body1{f.f1[0] * dt_, f.f1[1] * dt_};
+    const Vec2 on_b = pending_[k].b_is_body1 ? on_body1 : -on_body1;
+    r.normal_impulse = dot(on_b, r.normal);
+    r.tangent_impulse = dot(on_b, perp(r.normal));
+    if (r.normal_impulse != 0.0 || r.tangent_impulse != 0.0) records_.push_back(r);
+  }
+  dJointGroupEmpty(contact_group_);
+  publish();
+}
+
+void OdeEngine::keep_in_plane() {
+  for (dBodyID b : bodies_) {
+    if (!b) continue;
+    const dReal* r = dBodyGetRotation(b);
+    const dReal* p = dBodyGetPosition(b);
+    const dReal* w = dBodyGetAngularVel(b);
+    max_out_of_plane_ = std::max({max_out_of_plane_, std::abs(p[2]), std::abs(r[8] - 1.0)});
+    const double angle = std::atan2(r[4], r[0]);
+    dMatrix3 rz;
+    dRFromAxisAndAngle(rz, 0, 0, 1, angle);
+    dBodySetRotation(b, rz);
+    dBodySetAngularVel(b, 0, 0, w[2]);
+    dBodySetPosition(b, p[0], p[1], 0.0);
+    const dReal* v = dBodyGetLinearVel(b);
+    dBodySetLinearVel(b, v[0], v[1], 0.0);
+  }
+}
+
+void OdeEngine::publish() {
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const dBodyID b = bodies_[i];
+    if (!b) {
+      state_.position[i] = fixed_position_[i];
+      continue;
+    }
+    const dReal* p = dBodyGetPosition(b);
+    const dReal* r = dBodyGetRotation(b);
+    const dReal* v = dBodyGetLinearVel(b);
+    const dReal* w = dBodyGetAngularVel(b);
+    state_.position[i] = {p[0], p[1]};
+    state_.angle[i] = std::atan2(r[4], r[0]);
+    state_.velocity[i] = {v[0], v[1]};
+    state_.angular_velocity[i] = w[2];
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Engine> make_ode_engine(const Scene& scene) { return std::make_unique<OdeEngine>(scene); }
+
+}  // namespace floedem
