@@ -58,6 +58,10 @@ class Forcing {
   std::array<double, 3> environment_force(std::size_t i) const;
 
  private:
+  /// Whether a body's drag Jacobian is stiff at this dt (then the step is linearly implicit).
+  bool stiff(const std::array<double, 9>& d, double mass, double inertia) const;
+  static constexpr double kExplicitLimit = 0.5;
+
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   std::vector<std::size_t> prescribed_;
   const Scene& scene_;

@@ -243,7 +243,7 @@ void OdeEngine::keep_in_plane() {
     const dReal* r = dBodyGetRotation(b);
     const dReal* p = dBodyGetPosition(b);
     const dReal* w = dBodyGetAngularVel(b);
-    max_out_of_plane_ = std::max({max_out_of_plane_, std::abs(p[2]), std::abs(r[8] - 1.0)});
+    max_out_of_plane_ = std::max({max_out_of_plane_, std::abs(p[2]), std::abs(r[8]), std::abs(r[9])});  // z, tilt
     const double angle = std::atan2(r[4], r[0]);
     dMatrix3 rz;
     dRFromAxisAndAngle(rz, 0, 0, 1, angle);
