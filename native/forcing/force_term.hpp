@@ -69,6 +69,7 @@ class Forcing {
   ForceSums sums_;
   Loads loads_;
   BodyStates moved_;  ///< the state with prescribed velocities (towing scenes only)
+  std::vector<double> cached_rate_, cached_tan_, cached_half_tan_;  ///< Coriolis turn per body
 };
 
 // Builders, one per term file.

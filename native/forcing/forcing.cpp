@@ -99,6 +99,9 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
   sums_.q.resize(n);
   sums_.dq.resize(n);
   sums_.rotation_rate.resize(n);
+  cached_rate_.assign(n, 0.0);
+  cached_tan_.assign(n, 0.0);
+  cached_half_tan_.assign(n, 0.0);
 }
 
 std::vector<std::string_view> Forcing::names() const {
@@ -152,20 +155,32 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
     if (!implicit && f == 0.0) {
       dv = {dt_ * q[0] / mi, dt_ * q[1] / mi, dt_ * q[2] / ii};
     } else {
-      const double angle = first_step ? 0.5 * f * dt_ : f * dt_;
-      const double ft = (2.0 / dt_) * std::tan(0.5 * angle);  // f~, so that the Cayley turn is exact
-      const double cv = mi * ft;                              // C = cv [[0, -1], [1, 0]] on v
+      // f~ = (2 / dt) tan(angle / 2), so that the Cayley turn is exactly the angle; tan is
+      // cached per body (the rate rarely changes).
+      if (f != cached_rate_[i]) {
+        cached_rate_[i] = f;
+        cached_tan_[i] = std::tan(0.5 * f * dt_);
+        cached_half_tan_[i] = std::tan(0.25 * f * dt_);
+      }
+      const double ft = (2.0 / dt_) * (first_step ? cached_half_tan_[i] : cached_tan_[i]);
+      const double cv = mi * ft;  // C = cv [[0, -1], [1, 0]] on v
       const Vec2 v = state.velocity[i];
-      std::array<double, 9> a{};
-      if (implicit) a = sums_.dq[i];
-      for (double& x : a) x = -x;
-      a[0] += mi / dt_;
-      a[4] += mi / dt_;
-      a[8] += ii / dt_;
-      a[1] += -0.5 * cv;
-      a[3] += 0.5 * cv;
       const std::array<double, 3> rhs{q[0] + cv * v.y, q[1] - cv * v.x, q[2]};
-      dv = solve3(a, rhs);
+      if (!implicit) {
+        // [[M, -c], [c, M]] dv = rhs with M = m_I / dt, c = cv / 2: closed form.
+        const double m = mi / dt_, c = 0.5 * cv;
+        const double det = m * m + c * c;
+        dv = {(m * rhs[0] + c * rhs[1]) / det, (m * rhs[1] - c * rhs[0]) / det, dt_ * q[2] / ii};
+      } else {
+        std::array<double, 9> a = sums_.dq[i];
+        for (double& x : a) x = -x;
+        a[0] += mi / dt_;
+        a[4] += mi / dt_;
+        a[8] += ii / dt_;
+        a[1] += -0.5 * cv;
+        a[3] += 0.5 * cv;
+        dv = solve3(a, rhs);
+      }
     }
     loads_.force[i] = {scene_.engine_mass(i) * dv[0] / dt_, scene_.engine_mass(i) * dv[1] / dt_};
     loads_.torque[i] = scene_.engine_inertia(i) * dv[2] / dt_;
