@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "geometry/polygon.hpp"
+#include "run/simulation.hpp"
 #include "scenario/table_reader.hpp"
 
 namespace floedem {
@@ -127,7 +128,8 @@ EngineInfo Box2dEngine::info() const {
                 {"restitution_threshold", "0"},
                 {"sleeping", "off"},
                 {"continuous_collision", "off"}};
-  i.limitations = {"single precision (coordinates relative to the scene's mean centroid)",
+  i.limitations = {"a body may move at most 2 m (b2_maxTranslation) and turn pi/2 per step: longer steps are refused",
+                   "single precision (coordinates relative to the scene's mean centroid)",
                    "friction of a pair mixes as sqrt(mu_a mu_b) (equal here: one mu per scene)",
                    "position correction by Box2D's own nonlinear Gauss-Seidel (linear slop 0.005 m)"};
   return i;
@@ -191,6 +193,16 @@ void Box2dEngine::step(const Loads* loads) {
   }
   world_.Step(static_cast<float>(dt_), settings_.velocity_iterations, settings_.position_iterations);
   publish();
+  // Box2D clamps a body's motion per step at b2_maxTranslation (2 m) and b2_maxRotation
+  // (pi/2) without a word: refuse rather than return a silently slowed run.
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const double move = length(state_.velocity[i]) * dt_;
+    const double turn = std::abs(state_.angular_velocity[i]) * dt_;
+    if (move >= 0.999 * b2_maxTranslation || turn >= 0.999 * b2_maxRotation)
+      throw SolverFailure("box2d: body " + std::to_string(i) + " would move at least " + std::to_string(move) +
+                          " m (or turn " + std::to_string(turn) + " rad) in one step of " + std::to_string(dt_) +
+                          " s; Box2D caps a step at 2 m and pi/2 rad and would slow it silently: use a shorter dt");
+  }
 }
 
 void Box2dEngine::publish() {

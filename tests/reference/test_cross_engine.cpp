@@ -3,6 +3,7 @@
 // it; each such gap is stated below with its measured size and cause.
 #include <catch2/catch.hpp>
 
+#include "run/simulation.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -166,4 +167,12 @@ TEST_CASE("cross-engine: ODE and Bullet stay in the plane over 1e4 steps", "[cro
     const Outcome o = run(engine, text, 10000);
     CHECK(o.max_out_of_plane < 1e-6);  // m and rad: the issue's bound
   }
+}
+
+TEST_CASE("cross-engine: Box2D refuses steps it would silently shorten", "[cross]") {
+  // Box2D caps a body's motion at 2 m per step: a 1 m/s floe at dt = 5 s would be slowed.
+  const std::string text = test::header_toml(50.0, 5.0, 0.3, 0.3) + test::body_toml({"a", test::box({0, 0}, 10, 10), {1.0, 0.0}});
+  const Scene s = test::scene_from(text);
+  auto e = make_engine("box2d", s);
+  CHECK_THROWS_WITH(e->step(nullptr), Catch::Contains("box2d") && Catch::Contains("shorter dt"));
 }
