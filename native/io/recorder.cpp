@@ -344,6 +344,15 @@ std::int64_t Recorder::contact_rows() const {
   return static_cast<std::int64_t>(impl_->c_time.rows() + impl_->k_time.size());
 }
 
+void Recorder::update_engine_info(const EngineInfo& engine) {
+  try {
+    H5::Group eng = impl_->file.openGroup("/engine");
+    for (const auto& [k, v] : engine.settings) write_attribute(eng, k, v);
+  } catch (const H5::Exception& e) {
+    throw OutputError(partial_path_ + ": could not update /engine (" + e.getDetailMsg() + ")");
+  }
+}
+
 void Recorder::finish(const std::vector<std::pair<std::string, double>>& summary) {
   Impl& d = *impl_;
   try {

@@ -37,6 +37,8 @@ class Recorder {
   void write_contacts(double time, std::span<const ContactRecord> contacts);
   /// /tow at a frame: force of the last step, mean force since the last frame, tug position.
   void write_tow(Vec2 force, Vec2 mean_force, Vec2 tug_position);
+  /// Rewrites /engine's attributes (engines report measured figures, e.g. out-of-plane drift).
+  void update_engine_info(const EngineInfo& engine);
   /// Writes what is buffered, marks the file complete, closes it and renames it to `path`.
   void finish(const std::vector<std::pair<std::string, double>>& summary);
 

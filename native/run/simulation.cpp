@@ -115,6 +115,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   summary.frames = recorder.frames();
   summary.contact_rows = recorder.contact_rows();
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  recorder.update_engine_info(engine->info());
   recorder.finish({{"steps", static_cast<double>(summary.steps)},
                    {"kinetic_energy_start", summary.kinetic_energy_start},
                    {"kinetic_energy_end", summary.kinetic_energy_end},

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "geometry/polygon.hpp"
 #include "scenario/table_reader.hpp"
@@ -28,6 +29,12 @@
 namespace floedem {
 
 namespace {
+
+std::string format_g(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
 
 struct BulletSettings {
   int iterations = 50;
@@ -166,7 +173,7 @@ EngineInfo BulletEngine::info() const {
                 {"split_impulse", "on, threshold 0"},
                 {"restitution_velocity_threshold", std::to_string(threshold_)},
                 {"combine", "restitution max, friction min"},
-                {"max_out_of_plane", std::to_string(max_out_of_plane_)}};
+                {"max_out_of_plane", format_g(max_out_of_plane_)}};
   i.limitations = {"bodies are prisms held in the plane by linear and angular factors",
                    "up to 4 contact points per pair, top and bottom of the prism (compare impulses summed per pair)"};
   return i;

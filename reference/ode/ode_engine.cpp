@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 
 #include "scenario/table_reader.hpp"
@@ -30,7 +31,14 @@ namespace floedem {
 
 namespace {
 
+std::string format_g(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
 struct OdeSettings {
+  bool quick_step = true;  ///< dWorldQuickStep; "world" = dWorldStep (dense LCP: see above)
   int iterations = 50;
   double cfm = 1e-16;
   double erp = 0.2;
@@ -42,6 +50,7 @@ OdeSettings read_settings(const Scene& scene) {
   const auto it = scene.engine_settings.find("ode");
   if (it == scene.engine_settings.end()) return s;
   TableReader r(it->second, scene.source_path, "engine.ode");
+  s.quick_step = r.string("step", "quick", {"quick", "world"}) == "quick";
   s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
   s.cfm = r.real("cfm", s.cfm, Range::non_negative());
   s.erp = r.real("erp", s.erp, Range::closed(0.0, 1.0));
@@ -138,13 +147,13 @@ EngineInfo OdeEngine::info() const {
   i.name = "ode";
   i.version = "0.16 (double)";
   i.settings = {{"iterations", std::to_string(settings_.iterations)},
-                {"step", "dWorldQuickStep"},
+                {"step", settings_.quick_step ? "dWorldQuickStep" : "dWorldStep"},
                 {"cfm", std::to_string(settings_.cfm)},
                 {"erp", std::to_string(settings_.erp)},
                 {"max_correcting_velocity", std::to_string(settings_.max_correcting_velocity)},
                 {"friction", "dContactApprox1, in-plane tangent only"},
                 {"contact_geometry", "floedem 2-D narrow phase"},
-                {"max_out_of_plane", std::to_string(max_out_of_plane_)}};
+                {"max_out_of_plane", format_g(max_out_of_plane_)}};
   i.limitations = {"contact points from floedem's 2-D narrow phase, not ODE's colliders (one point per step for convex prisms)",
                    "contacts found only once bodies touch (no speculative contact): impacts resolve after up to v dt of overlap"};
   return i;
@@ -220,7 +229,10 @@ void OdeEngine::step(const Loads* loads) {
         dBodyAddTorque(bodies_[i], 0.0, 0.0, loads->torque[i]);
       }
   }
-  dWorldQuickStep(world_, dt_);
+  if (settings_.quick_step)
+    dWorldQuickStep(world_, dt_);
+  else
+    dWorldStep(world_, dt_);
   keep_in_plane();
   // Impulses: the joints' forces on body 1 times dt.
   records_.clear();
