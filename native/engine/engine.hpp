@@ -5,6 +5,7 @@
 // later environmental forcing and towing) is computed by shared code and handed to step()
 // as loads, so that engines differ only in how they treat contact.
 #include <cstdint>
+#include <cstdio>
 #include <map>
 #include <span>
 #include <string>
@@ -64,6 +65,14 @@ struct ContactRecord {
   double separation = 0.0;         ///< m, signed gap at the start of the step (< 0 overlapping)
   ContactKind kind = ContactKind::resting;
 };
+
+/// A real-valued setting or figure as text for EngineInfo: 15 significant digits, so that
+/// 1e-16 stays 1e-16 and 0.2 stays 0.2 (std::to_string would print both with 6 decimals).
+inline std::string setting_text(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.15g", v);
+  return b;
+}
 
 /// What an engine says about itself; written into the output's attributes.
 struct EngineInfo {

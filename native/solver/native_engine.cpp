@@ -104,13 +104,13 @@ EngineInfo NativeEngine::info() const {
   i.version = "floedem";
   i.settings = {
       {"velocity_iterations", std::to_string(settings_.velocity_iterations)},
-      {"tolerance", std::to_string(settings_.tolerance)},
+      {"tolerance", setting_text(settings_.tolerance)},
       {"warm_start", settings_.warm_start ? "true" : "false"},
       {"position_iterations", std::to_string(settings_.position_iterations)},
-      {"position_correction", std::to_string(settings_.position_correction)},
-      {"allowed_penetration", std::to_string(settings_.allowed_penetration)},
-      {"max_correction", std::to_string(settings_.max_correction)},
-      {"mean_sweeps_per_step", std::to_string(steps_ > 0 ? static_cast<double>(total_sweeps_) / static_cast<double>(steps_) : 0.0)},
+      {"position_correction", setting_text(settings_.position_correction)},
+      {"allowed_penetration", setting_text(settings_.allowed_penetration)},
+      {"max_correction", setting_text(settings_.max_correction)},
+      {"mean_sweeps_per_step", setting_text(steps_ > 0 ? static_cast<double>(total_sweeps_) / static_cast<double>(steps_) : 0.0)},
       {"cold_restarts", std::to_string(cold_restarts_)},
   };
   return i;

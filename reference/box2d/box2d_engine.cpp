@@ -124,7 +124,7 @@ EngineInfo Box2dEngine::info() const {
               std::to_string(b2_version.revision);
   i.settings = {{"velocity_iterations", std::to_string(settings_.velocity_iterations)},
                 {"position_iterations", std::to_string(settings_.position_iterations)},
-                {"polygon_radius", std::to_string(settings_.polygon_radius)},
+                {"polygon_radius", setting_text(settings_.polygon_radius)},
                 {"restitution_threshold", "0"},
                 {"sleeping", "off"},
                 {"continuous_collision", "off"}};

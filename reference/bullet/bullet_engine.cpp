@@ -30,12 +30,6 @@ namespace floedem {
 
 namespace {
 
-std::string format_g(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
-
 struct BulletSettings {
   int iterations = 50;
   double margin = 0.01;  ///< m, collision margin
@@ -168,12 +162,12 @@ EngineInfo BulletEngine::info() const {
   i.name = "bullet";
   i.version = std::to_string(btGetVersion() / 100) + "." + std::to_string(btGetVersion() % 100) + " (double)";
   i.settings = {{"iterations", std::to_string(settings_.iterations)},
-                {"margin", std::to_string(settings_.margin)},
-                {"prism_height", std::to_string(height_)},
+                {"margin", setting_text(settings_.margin)},
+                {"prism_height", setting_text(height_)},
                 {"split_impulse", "on, threshold 0"},
-                {"restitution_velocity_threshold", std::to_string(threshold_)},
+                {"restitution_velocity_threshold", setting_text(threshold_)},
                 {"combine", "restitution max, friction min"},
-                {"max_out_of_plane", format_g(max_out_of_plane_)}};
+                {"max_out_of_plane", setting_text(max_out_of_plane_)}};
   i.limitations = {"bodies are prisms held in the plane by linear and angular factors",
                    "up to 4 contact points per pair, top and bottom of the prism (compare impulses summed per pair)"};
   return i;

@@ -31,12 +31,6 @@ namespace floedem {
 
 namespace {
 
-std::string format_g(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
-
 struct OdeSettings {
   bool quick_step = true;  ///< dWorldQuickStep; "world" = dWorldStep (dense LCP: see above)
   int iterations = 50;
@@ -148,12 +142,12 @@ EngineInfo OdeEngine::info() const {
   i.version = "0.16 (double)";
   i.settings = {{"iterations", std::to_string(settings_.iterations)},
                 {"step", settings_.quick_step ? "dWorldQuickStep" : "dWorldStep"},
-                {"cfm", std::to_string(settings_.cfm)},
-                {"erp", std::to_string(settings_.erp)},
-                {"max_correcting_velocity", std::to_string(settings_.max_correcting_velocity)},
+                {"cfm", setting_text(settings_.cfm)},
+                {"erp", setting_text(settings_.erp)},
+                {"max_correcting_velocity", setting_text(settings_.max_correcting_velocity)},
                 {"friction", "dContactApprox1, in-plane tangent only"},
                 {"contact_geometry", "floedem 2-D narrow phase"},
-                {"max_out_of_plane", format_g(max_out_of_plane_)}};
+                {"max_out_of_plane", setting_text(max_out_of_plane_)}};
   i.limitations = {"contact points from floedem's 2-D narrow phase, not ODE's colliders (one point per step for convex prisms)",
                    "contacts found only once bodies touch (no speculative contact): impacts resolve after up to v dt of overlap"};
   return i;
