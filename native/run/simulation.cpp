@@ -8,10 +8,8 @@
 #include <limits>
 #include <sstream>
 
-#include "engine/registry.hpp"
-#include "forcing/force_term.hpp"
 #include "io/recorder.hpp"
-#include "towing/tow.hpp"
+#include "run/stepper.hpp"
 #include "version.hpp"
 
 namespace floedem {
@@ -69,38 +67,32 @@ class Progress {
 
 RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  std::unique_ptr<Engine> engine = make_engine(options.engine, scene);
-  Forcing forcing(scene);
+  Stepper stepper(scene, options.engine);
   RunInfo info;
-  for (const auto name : forcing.names()) info.forcing_terms.emplace_back(name);
+  for (const auto name : stepper.forcing().names()) info.forcing_terms.emplace_back(name);
   info.floedem_version = kFloedemVersion;
-  Recorder recorder(options.output, scene, engine->info(), info);
+  Recorder recorder(options.output, scene, stepper.engine().info(), info);
 
   RunSummary summary;
   summary.engine = options.engine;
   const std::int64_t steps = scene.run.steps();
-  const double dt = scene.run.dt;
-  summary.kinetic_energy_start = kinetic_energy(scene, engine->state());
-  TowMonitor tow(scene);
+  summary.kinetic_energy_start = kinetic_energy(scene, stepper.state());
+  TowMonitor& tow = stepper.tow();
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   if (tow.active()) recorder.write_tow({nan, nan}, {nan, nan}, tow.tug_position(0.0));  // no step yet
-  recorder.write_frame(0.0, engine->state());
+  recorder.write_frame(0.0, stepper.state());
   Progress progress(options.progress);
   for (std::int64_t k = 1; k <= steps; ++k) {
-    // Time as k * dt rather than a running sum: no drift over long runs.
-    const double t_start = static_cast<double>(k - 1) * dt;
-    const double t_end = static_cast<double>(k) * dt;
-    if (tow.active()) tow.before_step(engine->state(), t_start);
-    engine->step(forcing.evaluate(engine->state(), t_start));
-    const BodyStates& state = engine->state();
+    stepper.step();
+    const double t_end = stepper.time();
+    const BodyStates& state = stepper.state();
     if (!finite_state(state))
       throw SolverFailure("non-finite body state at step " + std::to_string(k) + " (t = " + std::to_string(t_end) +
                           " s); output so far kept in " + recorder.partial_path());
-    const auto contacts = engine->contacts();
+    const auto contacts = stepper.contacts();
     for (const ContactRecord& c : contacts)
       ++(c.kind == ContactKind::collision ? summary.collision_impulses : summary.resting_impulses);
     recorder.write_contacts(t_end, contacts);
-    if (tow.active()) tow.after_step(contacts, forcing.environment_force(scene.tow.body));
     if (k % scene.run.output_every == 0 || k == steps) {
       if (tow.active()) recorder.write_tow(tow.force(), tow.take_mean(), tow.tug_position(t_end));
       recorder.write_frame(t_end, state);
@@ -108,14 +100,14 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     progress.update(k, steps);
   }
   progress.done();
-  const BodyStates& state = engine->state();
+  const BodyStates& state = stepper.state();
   summary.steps = steps;
   summary.kinetic_energy_end = kinetic_energy(scene, state);
   for (const Vec2 v : state.velocity) summary.max_speed = std::max(summary.max_speed, length(v));
   summary.frames = recorder.frames();
   summary.contact_rows = recorder.contact_rows();
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  recorder.update_engine_info(engine->info());
+  recorder.update_engine_info(stepper.engine().info());
   recorder.finish({{"steps", static_cast<double>(summary.steps)},
                    {"kinetic_energy_start", summary.kinetic_energy_start},
                    {"kinetic_energy_end", summary.kinetic_energy_end},

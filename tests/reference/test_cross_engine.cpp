@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "run/simulation.hpp"
+#include "run/stepper.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -30,18 +31,17 @@ double setting(const EngineInfo& i, const std::string& key) {
 /// the polygons do; after the impact the bodies part and nothing else happens.
 constexpr int kImpactSteps = 5;
 
-Outcome run(const std::string& engine, const std::string& text, int steps, double dt = 0.01) {
+Outcome run(const std::string& engine, const std::string& text, int steps) {
   const Scene s = test::scene_from(text);
-  auto e = make_engine(engine, s);
-  Forcing forcing(s);
+  Stepper stepper(s, engine);
   Outcome o;
   for (int k = 0; k < steps; ++k) {
-    e->step(forcing.evaluate(e->state(), k * dt));
-    for (const ContactRecord& c : e->contacts())
+    stepper.step();
+    for (const ContactRecord& c : stepper.contacts())
       if (c.body_a == 0 && c.body_b == 1) o.impulse_on_b += c.normal_impulse;
   }
-  o.state = e->state();
-  o.max_out_of_plane = setting(e->info(), "max_out_of_plane");
+  o.state = stepper.state();
+  o.max_out_of_plane = setting(stepper.engine().info(), "max_out_of_plane");
   return o;
 }
 
@@ -145,13 +145,12 @@ TEST_CASE("cross-engine: a floe in a steady current against a fixed iceberg", "[
   for (const char* engine : kEngines) {
     INFO(engine);
     const Scene s = test::scene_from(text);
-    auto e = make_engine(engine, s);
-    Forcing forcing(s);
+    Stepper stepper(s, engine);
     double impulse = 0.0;
     for (int k = 0; k < 4000; ++k) {
-      e->step(forcing.evaluate(e->state(), k * 0.05));
+      stepper.step();
       if (k >= 3000)
-        for (const ContactRecord& c : e->contacts()) impulse += c.normal_impulse;
+        for (const ContactRecord& c : stepper.contacts()) impulse += c.normal_impulse;
     }
     // At rest on the iceberg: drag at the full current speed, mean over the last 50 s.
     CHECK(impulse / 50.0 == Approx(drag).epsilon(1e-3));

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "run/simulation.hpp"
+#include "run/stepper.hpp"
 #include "support.hpp"
 #include "towing/tow.hpp"
 
@@ -32,31 +33,25 @@ TEST_CASE("towing at constant speed in calm open water: the towing force is the 
   const std::string text = "[run]\nduration = 100.0\ndt = 0.5\n[environment]\n" + kBerg +
                            "[tow]\nmode = \"velocity\"\nbody = \"berg\"\nvelocity = [0.7, 0.0]\n";
   const Scene s = test::scene_from(text);
-  auto e = test::native(s);
-  Forcing forcing(s);
-  TowMonitor tow(s);
+  Stepper run(s, "native");
   for (int n = 0; n < 200; ++n) {
-    tow.before_step(e->state(), n * 0.5);
-    e->step(forcing.evaluate(e->state(), n * 0.5));
-    tow.after_step(e->contacts(), forcing.environment_force(0));
+    run.step();
+    const TowMonitor& tow = run.tow();
     // 1e-6 relative: the issue's bound; both sides are the same closed form up to round-off.
     CHECK(tow.force().x == Approx(drag_at(0.7)).epsilon(1e-6));
     CHECK(std::abs(tow.force().y) < 1e-9 * drag_at(0.7));
   }
-  CHECK(e->state().position[0].x == Approx(0.7 * 100.0).epsilon(1e-12));
-  CHECK(e->state().velocity[0].x == 0.7);
+  CHECK(run.state().position[0].x == Approx(0.7 * 100.0).epsilon(1e-12));
+  CHECK(run.state().velocity[0].x == 0.7);
 }
 
 TEST_CASE("towing with Coriolis: the constraint also holds the Coriolis force", "[tow]") {
   const std::string text = "[run]\nduration = 10.0\ndt = 0.5\n[environment]\nlatitude = 75.0\n" + kBerg +
                            "[tow]\nmode = \"velocity\"\nbody = \"berg\"\nvelocity = [0.7, 0.0]\n";
   const Scene s = test::scene_from(text);
-  auto e = test::native(s);
-  Forcing forcing(s);
-  TowMonitor tow(s);
-  tow.before_step(e->state(), 0.0);
-  e->step(forcing.evaluate(e->state(), 0.0));
-  tow.after_step(e->contacts(), forcing.environment_force(0));
+  Stepper run(s, "native");
+  run.step();
+  const TowMonitor& tow = run.tow();
   // -m f k x v = (0, -m f v) for v along x: the tow must supply +m f v across the path.
   const double f = 2.0 * 7.2921e-5 * std::sin(75.0 * M_PI / 180.0);
   CHECK(tow.force().y == Approx(1.5e9 * f * 0.7).epsilon(1e-12));
@@ -67,22 +62,18 @@ TEST_CASE("towing on a piecewise-linear path: the body follows it and pays for i
   const std::string text = "[run]\nduration = 200.0\ndt = 0.5\n[environment]\n" + kBerg +
                            "[tow]\nmode = \"velocity\"\nbody = \"berg\"\npath = [[0, 0.0, 0.0], [100, 0.5, 0.0]]\n";
   const Scene s = test::scene_from(text);
-  auto e = test::native(s);
-  Forcing forcing(s);
-  TowMonitor tow(s);
+  Stepper run(s, "native");
   for (int n = 0; n < 400; ++n) {
-    tow.before_step(e->state(), n * 0.5);
-    e->step(forcing.evaluate(e->state(), n * 0.5));
-    tow.after_step(e->contacts(), forcing.environment_force(0));
+    run.step();
     if (n == 99) {
       // Mid-way up the ramp, the step from 49.5 s to 50 s: m_I a + drag at the mid-step speed,
       // the velocity the body is moved with over the step.
       const double v = 0.005 * 49.75;
-      CHECK(tow.force().x == Approx(1.5e9 * 1.5 * 0.005 + drag_at(v)).epsilon(1e-9));
+      CHECK(run.tow().force().x == Approx(1.5e9 * 1.5 * 0.005 + drag_at(v)).epsilon(1e-9));
     }
   }
   // Displacement: 1/2 0.5 m/s 100 s + 0.5 m/s 100 s = 75 m, exact for the piecewise-linear path.
-  CHECK(e->state().position[0].x == Approx(75.0).epsilon(1e-12));
+  CHECK(run.state().position[0].x == Approx(75.0).epsilon(1e-12));
 }
 
 TEST_CASE("rope towing in steady state: the rope carries the drag", "[tow]") {
@@ -92,18 +83,13 @@ TEST_CASE("rope towing in steady state: the rope carries the drag", "[tow]") {
                            "length = 300.0\ndamping = 3e7\nattachment = [100.0, 0.0]\n";
   const Scene s = test::scene_from(text);
   CHECK(s.tow.tug_start.x == Approx(400.0));  // attachment + rope length along the tug's heading
-  auto e = test::native(s);
-  Forcing forcing(s);
-  TowMonitor tow(s);
-  for (int n = 0; n < 30000; ++n) {
-    tow.before_step(e->state(), n * 1.0);
-    e->step(forcing.evaluate(e->state(), n * 1.0));
-    tow.after_step(e->contacts(), forcing.environment_force(0));
-  }
+  Stepper run(s, "native");
+  for (int n = 0; n < 30000; ++n) run.step();
+  const TowMonitor& tow = run.tow();
   // 1e-4 relative: the issue's bound. 30 000 s is ~20 drag time scales m_I / (K v).
   CHECK(tow.force().x == Approx(drag_at(0.5)).epsilon(1e-4));
-  CHECK(e->state().velocity[0].x == Approx(0.5).epsilon(1e-4));
-  CHECK(std::abs(e->state().angle[0]) < 1e-9);  // pulled from ahead of its centroid: stays on course
+  CHECK(run.state().velocity[0].x == Approx(0.5).epsilon(1e-4));
+  CHECK(std::abs(run.state().angle[0]) < 1e-9);  // pulled from ahead of its centroid: stays on course
 }
 
 TEST_CASE("a slack rope carries nothing", "[tow]") {

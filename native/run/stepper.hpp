@@ -1,0 +1,44 @@
+#pragma once
+// One step of a scene on an engine, in the one order every caller needs: towing bookkeeping,
+// forcing at the start of the step, the engine's step, the towing force of the step. The
+// driver (simulation.cpp) records around it; tests and benchmarks step with it directly.
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "engine/engine.hpp"
+#include "forcing/force_term.hpp"
+#include "scene/scene.hpp"
+#include "towing/tow.hpp"
+
+namespace floedem {
+
+class Stepper {
+ public:
+  /// Builds the named engine (InputError for bad settings) and the scene's forcing.
+  Stepper(const Scene& scene, const std::string& engine);
+
+  /// Advances by one dt.
+  void step();
+
+  std::int64_t steps_done() const { return steps_; }
+  /// Model time after the steps done: k dt, not a running sum (no drift over long runs).
+  double time() const { return static_cast<double>(steps_) * dt_; }
+  const Engine& engine() const { return *engine_; }
+  const BodyStates& state() const { return engine_->state(); }
+  std::span<const ContactRecord> contacts() const { return engine_->contacts(); }
+  const Forcing& forcing() const { return forcing_; }
+  TowMonitor& tow() { return tow_; }
+  const TowMonitor& tow() const { return tow_; }
+
+ private:
+  const Scene& scene_;
+  double dt_;
+  std::unique_ptr<Engine> engine_;
+  Forcing forcing_;
+  TowMonitor tow_;
+  std::int64_t steps_ = 0;
+};
+
+}  // namespace floedem
