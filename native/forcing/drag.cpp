@@ -79,4 +79,30 @@ void add_skin_drag(ForceSums& sums, std::size_t body, const std::vector<AreaPoin
   }
 }
 
+DistributedDrag::DistributedDrag(std::string_view name, Kind kind, const EnvironmentSpec& environment)
+    : name_(name), kind_(kind), settings_{environment.rotational_damping, environment.drag_reference_speed} {}
+
+void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_polygon, std::vector<DragSlab> slabs) {
+  Entry e{body, {}, {}, std::move(slabs)};
+  if (kind_ == Kind::form)
+    e.edges = edge_points(local_polygon);
+  else
+    e.points = area_points(local_polygon);
+  entries_.push_back(std::move(e));
+}
+
+void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
+  for (const Entry& e : entries_) {
+    const Rot rot = Rot::from_angle(s.angle[e.body]);
+    for (const DragSlab& slab : e.slabs) {
+      if (kind_ == Kind::form)
+        add_form_drag(sums, e.body, e.edges, slab.scale, slab.c, slab.flow, s.velocity[e.body], s.angular_velocity[e.body],
+                      rot, settings_);
+      else
+        add_skin_drag(sums, e.body, e.points, slab.scale, slab.c, slab.flow, s.velocity[e.body], s.angular_velocity[e.body],
+                      rot, settings_);
+    }
+  }
+}
+
 }  // namespace floedem

@@ -44,4 +44,42 @@ void add_form_drag(ForceSums& sums, std::size_t body, const std::vector<EdgePoin
 void add_skin_drag(ForceSums& sums, std::size_t body, const std::vector<AreaPoint>& points, double scale, double c,
                    Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings);
 
+/// One layer of a body that feels a drag: its coefficient (1/2 rho C h for form drag, rho C
+/// for skin drag), the scale of the outline, and the flow it sits in.
+struct DragSlab {
+  double c = 0.0;
+  double scale = 1.0;
+  Vec2 flow;
+};
+
+/// A drag term distributed over the bodies' outlines (form) or areas (skin), slab by slab.
+/// The four drag terms are instances of it; each term's file says which bodies and slabs.
+class DistributedDrag final : public ForceTerm {
+ public:
+  enum class Kind { form, skin };
+  DistributedDrag(std::string_view name, Kind kind, const EnvironmentSpec& environment);
+  void add_body(std::size_t body, const std::vector<Vec2>& local_polygon, std::vector<DragSlab> slabs);
+  bool empty() const { return entries_.empty(); }
+  std::string_view name() const override { return name_; }
+  void add(const BodyStates& state, double time, ForceSums& sums) const override;
+
+ private:
+  struct Entry {
+    std::size_t body;
+    std::vector<EdgePoint> edges;   // form drag
+    std::vector<AreaPoint> points;  // skin drag
+    std::vector<DragSlab> slabs;
+  };
+  std::string_view name_;
+  Kind kind_;
+  DragSettings settings_;
+  std::vector<Entry> entries_;
+};
+
+/// The term, or nullptr when no body needs it.
+inline std::unique_ptr<ForceTerm> if_used(std::unique_ptr<DistributedDrag> term) {
+  if (term->empty()) return nullptr;
+  return term;
+}
+
 }  // namespace floedem
