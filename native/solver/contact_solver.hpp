@@ -9,13 +9,10 @@
 
 namespace floedem {
 
-/// Body data the solver reads and writes every step (structure of arrays).
-struct BodyArrays {
-  std::vector<Vec2> position;
-  std::vector<double> angle;
+/// Body data the solver reads and writes every step (structure of arrays). The engine's
+/// published state is this object itself: position, angle and velocities are BodyStates'.
+struct BodyArrays : BodyStates {
   std::vector<Rot> rotation;
-  std::vector<Vec2> velocity;
-  std::vector<double> angular_velocity;
   std::vector<double> inv_mass;
   std::vector<double> inv_inertia;
 };

@@ -26,7 +26,7 @@ class NativeEngine final : public Engine {
  public:
   explicit NativeEngine(const Scene& scene);
   void step(const Loads* loads) override;
-  const BodyStates& state() const override { return state_; }
+  const BodyStates& state() const override { return bodies_; }
   std::span<const ContactRecord> contacts() const override { return records_; }
   EngineInfo info() const override;
 
@@ -36,7 +36,6 @@ class NativeEngine final : public Engine {
   void apply_loads(const Loads& loads);
   void integrate();
   void record();
-  void publish_state();
   PartGeometry part_geometry(std::int32_t k) const;
   void solve_contacts();
   double contact_kinetic_energy() const;
@@ -57,7 +56,6 @@ class NativeEngine final : public Engine {
   std::vector<PartPair> pairs_;
   std::vector<Manifold> manifolds_, previous_manifolds_;
   std::vector<ContactRecord> records_;
-  BodyStates state_;
   // Measured figures, reported by info(): solver work and warm-start fallbacks over the run.
   std::int64_t total_sweeps_ = 0;
   std::int64_t steps_ = 0;
@@ -95,7 +93,6 @@ NativeEngine::NativeEngine(const Scene& scene)
   linear_reach_.resize(n);
   angular_reach_.resize(n);
   part_reach_.resize(parts_.size());
-  publish_state();
 }
 
 EngineInfo NativeEngine::info() const {
@@ -132,7 +129,6 @@ void NativeEngine::step(const Loads* loads) {
   if (settings_.position_iterations > 0 && !manifolds_.empty())
     solve_positions(manifolds_, bodies_, settings_);  // 6. drift correction, positions only
   record();                                    // 7. impulses for the recorder
-  publish_state();
   ++steps_;
 }
 
@@ -281,12 +277,6 @@ void NativeEngine::record() {
   }
 }
 
-void NativeEngine::publish_state() {
-  state_.position = bodies_.position;
-  state_.angle = bodies_.angle;
-  state_.velocity = bodies_.velocity;
-  state_.angular_velocity = bodies_.angular_velocity;
-}
 
 }  // namespace
 
