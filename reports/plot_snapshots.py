@@ -13,20 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 
-
-def body_polygons(f, frame):
-    """World polygons of every body at one frame (local vertices turned and moved)."""
-    verts = f["bodies/polygon_vertices"][:]
-    offsets = f["bodies/polygon_offsets"][:]
-    pos = f["bodies/position"][frame]
-    ang = f["bodies/angle"][frame]
-    out = []
-    for k in range(len(offsets) - 1):
-        local = verts[offsets[k]:offsets[k + 1]]
-        c, s = np.cos(ang[k]), np.sin(ang[k])
-        rot = np.array([[c, -s], [s, c]])
-        out.append(local @ rot.T + pos[k])
-    return out
+from floedem_h5 import body_polygons  # noqa: E402
 
 
 def main():

@@ -1,6 +1,10 @@
 #pragma once
 // Helpers shared by the tests: scenes from TOML text, engines, polygons as TOML.
+#include <sys/wait.h>
+
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -11,6 +15,21 @@
 #include "scenario/scenario.hpp"
 
 namespace floedem::test {
+
+/// The floedem command line run with `args`: exit code and stdout + stderr together.
+struct CliResult {
+  int code;
+  std::string output;
+};
+inline CliResult run_cli(const std::string& args) {
+  const std::string cmd = std::string(FLOEDEM_EXE) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
 
 inline Scene scene_from(const std::string& toml, const std::vector<std::string>& overrides = {}) {
   return parse_scenario(toml, "test.toml", overrides);

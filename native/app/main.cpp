@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "app/field_command.hpp"
 #include "engine/registry.hpp"
 #include "io/recorder.hpp"
 #include "run/simulation.hpp"
@@ -56,6 +57,9 @@ int main(int argc, char** argv) {
 
   CLI::App* list = app.add_subcommand("engines", "list the engines this build has");
 
+  floedem::FieldCommand field_options;
+  CLI::App* field = floedem::add_field_command(app, field_options);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -68,6 +72,7 @@ int main(int argc, char** argv) {
       for (const auto& e : floedem::engines()) std::cout << e.name << "\t" << e.description << "\n";
       return 0;
     }
+    if (field->parsed()) return floedem::run_field_command(field_options);
     return run_command(scenario, engine, output, overrides, quiet);
   } catch (const floedem::InputError& e) {
     std::cerr << "floedem: error: " << e.what() << "\n";

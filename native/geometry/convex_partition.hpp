@@ -1,5 +1,5 @@
 #pragma once
-// Splits a simple polygon into convex parts. The only place CGAL is included: it costs
+// Splits a simple polygon into convex parts. CGAL is included here and in field/power_diagram.cpp only: it costs
 // tens of seconds and about a gigabyte of memory per translation unit to compile.
 #include <span>
 #include <vector>

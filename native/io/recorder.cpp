@@ -353,6 +353,43 @@ void Recorder::update_engine_info(const EngineInfo& engine) {
   }
 }
 
+namespace {
+H5::Group open_or_create(H5::H5File& file, const std::string& group) {
+  return file.nameExists(group) ? file.openGroup(group) : file.createGroup(group);
+}
+}  // namespace
+
+void Recorder::annotate(const std::string& group, const std::vector<std::pair<std::string, std::string>>& text,
+                        const std::vector<std::pair<std::string, double>>& numbers) {
+  try {
+    H5::Group g = open_or_create(impl_->file, group);
+    for (const auto& [k, v] : text) write_attribute(g, k, v);
+    for (const auto& [k, v] : numbers) write_attribute(g, k, v);
+  } catch (const H5::Exception& e) {
+    throw OutputError(partial_path_ + ": could not write " + group + " (" + e.getDetailMsg() + ")");
+  }
+}
+
+void Recorder::write_polygons(const std::string& group, const std::string& name,
+                              const std::vector<std::vector<Vec2>>& polygons) {
+  std::vector<double> vertices;
+  std::vector<std::int64_t> offsets{0};
+  for (const auto& p : polygons) {
+    for (const Vec2 v : p) {
+      vertices.push_back(v.x);
+      vertices.push_back(v.y);
+    }
+    offsets.push_back(static_cast<std::int64_t>(vertices.size() / 2));
+  }
+  try {
+    H5::Group g = open_or_create(impl_->file, group);
+    write_fixed(g, name + "_vertices", H5::PredType::NATIVE_DOUBLE, vertices, {vertices.size() / 2, 2});
+    write_fixed(g, name + "_offsets", H5::PredType::NATIVE_INT64, offsets, {offsets.size()});
+  } catch (const H5::Exception& e) {
+    throw OutputError(partial_path_ + ": could not write " + group + "/" + name + " (" + e.getDetailMsg() + ")");
+  }
+}
+
 void Recorder::finish(const std::vector<std::pair<std::string, double>>& summary) {
   Impl& d = *impl_;
   try {

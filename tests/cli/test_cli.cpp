@@ -1,10 +1,6 @@
 // The command line: exit codes, one-line errors, no output left behind on bad input.
 #include <catch2/catch.hpp>
 
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -14,20 +10,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;
-};
-
-Result run(const std::string& args) {
-  const std::string cmd = std::string(FLOEDEM_EXE) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using Result = floedem::test::CliResult;
+Result run(const std::string& args) { return floedem::test::run_cli(args); }
 
 fs::path dir_for(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("floedem-cli-" + name + "-" + std::to_string(::getpid()));

@@ -1,0 +1,79 @@
+#include "field/field_file.hpp"
+
+#include <sstream>
+
+#include "engine/engine.hpp"
+#include "io/recorder.hpp"
+
+namespace floedem {
+
+std::vector<BodySpec> field_floes(const Field& field, double density, const std::string& prefix) {
+  std::vector<BodySpec> out;
+  out.reserve(field.floes.size());
+  for (std::size_t i = 0; i < field.floes.size(); ++i) {
+    BodySpec b;
+    b.name = prefix + std::to_string(i);
+    b.kind = BodyKind::floe;
+    b.polygon = field.floes[i];
+    b.thickness = field.thickness[i];
+    b.density = density;
+    out.push_back(std::move(b));
+  }
+  return out;
+}
+
+std::string describe(const ThicknessDistribution& t) {
+  std::ostringstream s;
+  s.precision(6);
+  switch (t.kind) {
+    case ThicknessDistribution::Kind::constant: s << t.value << " m"; break;
+    case ThicknessDistribution::Kind::uniform: s << "uniform on [" << t.min << ", " << t.max << "] m"; break;
+    case ThicknessDistribution::Kind::lognormal: s << "lognormal, mean " << t.mean << " m, std " << t.std << " m"; break;
+  }
+  return s.str();
+}
+
+void write_field_file(const std::string& path, const Field& field, const FieldSpec& spec, double density,
+                      const std::string& floedem_version) {
+  Scene scene;
+  scene.source_path = path;
+  scene.bodies = field_floes(field, density);
+  scene.output.contacts = ContactOutput::none;
+  scene.derive();
+  EngineInfo engine{"none (field generator)", "", {}, {}};
+  Recorder recorder(path, scene, engine, RunInfo{{}, floedem_version});
+  BodyStates state;
+  state.resize(scene.bodies.size());
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) state.position[i] = scene.bodies[i].centroid;
+  recorder.write_frame(0.0, state);
+  const FieldStats& st = field.stats;
+  recorder.annotate(
+      "/field",
+      {{"method", "power diagram with cells of prescribed areas (damped Newton), Lloyd steps, cells shrunk to the floe areas"},
+       {"thickness", describe(spec.thickness)},
+       {"seed", std::to_string(spec.seed)}},
+      {{"origin_x", spec.origin.x},
+       {"origin_y", spec.origin.y},
+       {"width", spec.width},
+       {"height", spec.height},
+       {"concentration", spec.concentration},
+       {"alpha", spec.alpha},
+       {"d_min", spec.d_min},
+       {"d_max", spec.d_max},
+       {"irregularity", spec.irregularity},
+       {"density", density},
+       {"floes", static_cast<double>(st.floes)},
+       {"free_area", st.free_area},
+       {"ice_area", st.ice_area},
+       {"concentration_achieved", st.concentration},
+       {"alpha_fitted", st.fit.alpha},
+       {"alpha_fitted_stderr", st.fit.stderr_alpha},
+       {"newton_iterations", static_cast<double>(st.newton_iterations)},
+       {"lloyd_steps", static_cast<double>(st.lloyd_steps)},
+       {"max_cell_area_error", st.max_cell_area_error},
+       {"floes_short_of_area", static_cast<double>(st.floes_short_of_area)}});
+  recorder.write_polygons("/field", "keep_out", spec.keep_out);
+  recorder.finish({});
+}
+
+}  // namespace floedem

@@ -1,0 +1,23 @@
+#pragma once
+// A generated field as scene bodies, and as a field file: the /bodies layout of a run's
+// output with one frame at t = 0 (written by the same Recorder), plus /field with the
+// generator's parameters and what it achieved. io/body_frame.hpp reads both.
+#include <string>
+#include <vector>
+
+#include "field/field_generator.hpp"
+#include "scene/scene.hpp"
+
+namespace floedem {
+
+/// The floes of a field as scene bodies named prefix + index, at rest, of the given density.
+std::vector<BodySpec> field_floes(const Field& field, double density, const std::string& prefix = "field-");
+
+/// Writes FIELD.h5 (under FIELD.h5.partial until complete). Throws OutputError.
+void write_field_file(const std::string& path, const Field& field, const FieldSpec& spec, double density,
+                      const std::string& floedem_version);
+
+/// The thickness distribution in words, for attributes and messages ("1.16 m", ...).
+std::string describe(const ThicknessDistribution& t);
+
+}  // namespace floedem
