@@ -40,7 +40,7 @@ def draw_field(f, out):
     ax.set_title(f"{len(floes)} floes, concentration {g['concentration_achieved']:.4f} "
                  f"(target {g['concentration']:.3f}), seed {g['seed']}")
     fig.tight_layout()
-    fig.savefig(out, dpi=150 if len(floes) < 20000 else 300)
+    fig.savefig(out, dpi=110 if len(floes) < 20000 else 250)
     plt.close(fig)
 
 

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "engine/registry.hpp"
+#include "field/field_generator.hpp"
 #include "forcing/force_term.hpp"
 #include "scenario/scenario.hpp"
 #include "solver/broad_phase.hpp"
@@ -86,6 +87,28 @@ void BM_StepFullEnvironment(benchmark::State& state) {
 BENCHMARK(BM_StepNoEnvironment)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_StepCoriolisOnly)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_StepFullEnvironment)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
+/// Field generation (issue 4's targets: 1e4 floes under 2 s, 1e5 under 20 s on 2 cores):
+/// alpha 2, d 2..50 m, C 0.5, default irregularity; the square domain holds N floes.
+void BM_FieldGenerator(benchmark::State& state) {
+  FieldSpec s;
+  s.concentration = 0.5;
+  s.alpha = 2.0;
+  s.d_min = 2.0;
+  s.d_max = 50.0;
+  s.thickness.value = 1.0;
+  const double side = std::sqrt(static_cast<double>(state.range(0)) *
+                                TruncatedPowerLaw{s.alpha, s.d_min, s.d_max}.mean_area() / s.concentration);
+  s.width = s.height = side;
+  std::size_t floes = 0;
+  for (auto _ : state) {
+    const Field f = generate_field(s);
+    floes = f.stats.floes;
+    benchmark::DoNotOptimize(f.floes.data());
+  }
+  state.counters["floes"] = static_cast<double>(floes);
+}
+BENCHMARK(BM_FieldGenerator)->Arg(10000)->Arg(100000)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 }  // namespace
 
