@@ -4,6 +4,7 @@
 #include <Eigen/SparseCore>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -15,6 +16,7 @@
 #include "geometry/convex_partition.hpp"
 #include "geometry/polygon.hpp"
 #include "geometry/sat.hpp"
+#include "parallel/threads.hpp"
 
 namespace floedem {
 namespace {
@@ -214,18 +216,20 @@ void compute_cells(const std::vector<Vec2>& sites, const std::vector<double>& w,
   out.centroid.assign(n, Vec2{});
   out.hessian.clear();
   if (polygons) polygons->assign(n, {});
-  // Cells are independent: split the sites into contiguous blocks, one per thread, each with
-  // its own matrix entries, joined in block order. The entries come out in site order
-  // whatever the thread count, so the field does not depend on it (bit for bit).
-  const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
-  const std::size_t blocks = std::min(threads, std::max<std::size_t>(1, n / 4096));
+  // Cells are independent: contiguous blocks of sites (fixed by n alone), each with its own
+  // matrix entries, joined in block order, spread over the worker threads. The entries come
+  // out in site order whatever the thread count, so the field does not depend on it.
+  const std::size_t blocks = std::clamp<std::size_t>(n / 2048, 1, 64);
   std::vector<std::vector<Eigen::Triplet<double>>> entries(blocks);
-  auto block = [&](std::size_t part) {
-    cell_block(sites, w, domain, adj, part * n / blocks, (part + 1) * n / blocks, out, entries[part], polygons);
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t part; (part = next.fetch_add(1)) < blocks;)
+      cell_block(sites, w, domain, adj, part * n / blocks, (part + 1) * n / blocks, out, entries[part], polygons);
   };
+  const std::size_t threads = std::min<std::size_t>(worker_threads(), blocks);
   std::vector<std::thread> pool;
-  for (std::size_t part = 1; part < blocks; ++part) pool.emplace_back(block, part);
-  block(0);
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
   for (std::thread& t : pool) t.join();
   std::size_t total = 0;
   for (const auto& e : entries) total += e.size();

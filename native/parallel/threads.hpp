@@ -1,0 +1,23 @@
+#pragma once
+// How many worker threads the parallel parts of floedem use: the environment variable
+// FLOEDEM_THREADS (1 to 256) when set, else the machine's hardware threads. Results never
+// depend on it (work is split into blocks fixed by the problem, joined in a fixed order).
+#include <charconv>
+#include <cstdlib>
+#include <string_view>
+#include <thread>
+
+namespace floedem {
+
+inline unsigned worker_threads() {
+  if (const char* env = std::getenv("FLOEDEM_THREADS")) {
+    const std::string_view text(env);
+    unsigned n = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+    if (ec == std::errc{} && end == text.data() + text.size() && n >= 1 && n <= 256) return n;
+  }
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw == 0 ? 1 : hw;
+}
+
+}  // namespace floedem
