@@ -70,6 +70,12 @@ class Forcing {
   Loads loads_;
   BodyStates moved_;  ///< the state with prescribed velocities (towing scenes only)
   std::vector<double> cached_rate_, cached_tan_, cached_half_tan_;  ///< Coriolis turn per body
+  struct BodyHot {
+    bool moves = false;  ///< neither fixed nor prescribed
+    double mass = 0.0, mass_with_added = 0.0, inertia_with_added = 0.0;
+    double engine_mass = 0.0, engine_inertia = 0.0;
+  };
+  std::vector<BodyHot> hot_;
 };
 
 // Builders, one per term file.

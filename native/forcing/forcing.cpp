@@ -102,6 +102,18 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
   cached_rate_.assign(n, 0.0);
   cached_tan_.assign(n, 0.0);
   cached_half_tan_.assign(n, 0.0);
+  // What the per-step loop reads, packed per body: the scene's bodies are large records.
+  hot_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodySpec& b = scene.bodies[i];
+    BodyHot& h = hot_[i];
+    h.moves = !(b.fixed || b.prescribed);
+    h.mass = b.mass;
+    h.mass_with_added = b.mass * (1.0 + b.added_mass_coefficient);
+    h.inertia_with_added = b.inertia * (1.0 + b.added_mass_coefficient);
+    h.engine_mass = scene.engine_mass(i);
+    h.engine_inertia = scene.engine_inertia(i);
+  }
 }
 
 std::vector<std::string_view> Forcing::names() const {
@@ -137,20 +149,20 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
   sums_.any_jacobian = sums_.any_rotation = false;
   for (const auto& t : terms_) t->add(*at, time, sums_);
 
-  const std::size_t n = scene_.bodies.size();
+  const std::size_t n = hot_.size();
   const bool first_step = time == 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    const BodySpec& b = scene_.bodies[i];
-    if (b.fixed || b.prescribed) {
+    const BodyHot& h = hot_[i];
+    if (!h.moves) {
       loads_.force[i] = {};
       loads_.torque[i] = 0.0;
       continue;
     }
-    const double mi = b.mass * (1.0 + b.added_mass_coefficient);
-    const double ii = b.inertia * (1.0 + b.added_mass_coefficient);
+    const double mi = h.mass_with_added;
+    const double ii = h.inertia_with_added;
     const std::array<double, 3>& q = sums_.q[i];
     std::array<double, 3> dv;
-    const double f = sums_.any_rotation ? sums_.rotation_rate[i] * b.mass / mi : 0.0;
+    const double f = sums_.any_rotation ? sums_.rotation_rate[i] * h.mass / mi : 0.0;
     const bool implicit = sums_.any_jacobian && stiff(sums_.dq[i], mi, ii);
     if (!implicit && f == 0.0) {
       dv = {dt_ * q[0] / mi, dt_ * q[1] / mi, dt_ * q[2] / ii};
@@ -182,8 +194,8 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
         dv = solve3(a, rhs);
       }
     }
-    loads_.force[i] = {scene_.engine_mass(i) * dv[0] / dt_, scene_.engine_mass(i) * dv[1] / dt_};
-    loads_.torque[i] = scene_.engine_inertia(i) * dv[2] / dt_;
+    loads_.force[i] = {h.engine_mass * dv[0] / dt_, h.engine_mass * dv[1] / dt_};
+    loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
   }
   return &loads_;
 }
