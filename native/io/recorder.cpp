@@ -117,6 +117,9 @@ struct Recorder::Impl {
   std::vector<std::int32_t> k_body_a, k_body_b;
   std::vector<std::uint8_t> k_kind;
   H5::EnumType kind_type = contact_kind_type();
+  // Collision events.
+  Series e_time, e_body_a, e_body_b, e_impulse, e_mass, e_approach, e_restitution, e_duration, e_mean, e_peak;
+  std::vector<CollisionRow> events;
   ContactOutput contact_output = ContactOutput::all;
   // Towing.
   bool tow = false;
@@ -155,6 +158,27 @@ struct Recorder::Impl {
       c_kind.append(k_kind.data(), rows);
       k_time.clear(); k_body_a.clear(); k_body_b.clear(); k_point.clear(); k_normal.clear();
       k_normal_impulse.clear(); k_tangent_impulse.clear(); k_approach.clear(); k_separation.clear(); k_kind.clear();
+    }
+    if (!events.empty()) {
+      const hsize_t n = events.size();
+      auto column = [&](Series& s, auto member) {
+        using T = std::remove_cvref_t<decltype(events[0].*member)>;
+        std::vector<T> v;
+        v.reserve(n);
+        for (const CollisionRow& r : events) v.push_back(r.*member);
+        s.append(v.data(), n);
+      };
+      column(e_time, &CollisionRow::time);
+      column(e_body_a, &CollisionRow::body_a);
+      column(e_body_b, &CollisionRow::body_b);
+      column(e_impulse, &CollisionRow::normal_impulse);
+      column(e_mass, &CollisionRow::effective_mass);
+      column(e_approach, &CollisionRow::approach_speed);
+      column(e_restitution, &CollisionRow::restitution_achieved);
+      column(e_duration, &CollisionRow::duration);
+      column(e_mean, &CollisionRow::mean_force);
+      column(e_peak, &CollisionRow::peak_force);
+      events.clear();
     }
   }
 
@@ -254,6 +278,23 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     d.c_separation = Series(contacts, "separation", H5::PredType::NATIVE_DOUBLE, {}, kc);
     d.c_kind = Series(contacts, "kind", d.kind_type, {}, kc);
     d.contact_output = scene.output.contacts;
+    {
+      H5::Group events = d.file.createGroup("/contacts/collisions");
+      write_attribute(events, "duration_coefficient", scene.contact.duration_coefficient);
+      write_attribute(events, "duration_model",
+                      "estimated from the impulse: tau = duration_coefficient sqrt(effective_mass) (MODEL.md 4)");
+      constexpr hsize_t ke = 1024;
+      d.e_time = Series(events, "time", H5::PredType::NATIVE_DOUBLE, {}, ke);
+      d.e_body_a = Series(events, "body_a", H5::PredType::NATIVE_INT32, {}, ke);
+      d.e_body_b = Series(events, "body_b", H5::PredType::NATIVE_INT32, {}, ke);
+      d.e_impulse = Series(events, "normal_impulse", H5::PredType::NATIVE_DOUBLE, {}, ke);
+      d.e_mass = Series(events, "effective_mass", H5::PredType::NATIVE_DOUBLE, {}, ke);
+      d.e_approach = Series(events, "approach_speed", H5::PredType::NATIVE_DOUBLE, {}, ke);
+      d.e_restitution = Series(events, "restitution_achieved", H5::PredType::NATIVE_DOUBLE, {}, ke);
+      d.e_duration = Series(events, "duration", H5::PredType::NATIVE_DOUBLE, {}, ke);
+      d.e_mean = Series(events, "mean_force", H5::PredType::NATIVE_DOUBLE, {}, ke);
+      d.e_peak = Series(events, "peak_force", H5::PredType::NATIVE_DOUBLE, {}, ke);
+    }
 
     if (scene.tow.mode != TowSpec::Mode::none) {
       d.tow = true;
@@ -327,6 +368,21 @@ void Recorder::write_contacts(double time, std::span<const ContactRecord> contac
   } catch (const H5::Exception& e) {
     throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full?");
   }
+}
+
+void Recorder::write_collisions(std::span<const CollisionRow> rows) {
+  Impl& d = *impl_;
+  d.events.insert(d.events.end(), rows.begin(), rows.end());
+  try {
+    if (d.events.size() >= 1024) d.write_buffers();
+    d.maybe_flush();
+  } catch (const H5::Exception& e) {
+    throw OutputError(partial_path_ + ": could not write collisions (" + e.getDetailMsg() + "); disk full?");
+  }
+}
+
+std::int64_t Recorder::collision_rows() const {
+  return static_cast<std::int64_t>(impl_->e_time.rows() + impl_->events.size());
 }
 
 void Recorder::write_tow(Vec2 force, Vec2 mean_force, Vec2 tug_position) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "contacts/collision_forces.hpp"
 #include "engine/engine.hpp"
 #include "scene/scene.hpp"
 
@@ -35,6 +36,8 @@ class Recorder {
   void write_frame(double time, const BodyStates& state);
   /// Contact rows (all, collisions only, or none, as the scene's [output] says).
   void write_contacts(double time, std::span<const ContactRecord> contacts);
+  /// Collision events that ended (/contacts/collisions).
+  void write_collisions(std::span<const CollisionRow> rows);
   /// /tow at a frame: force of the last step, mean force since the last frame, tug position.
   void write_tow(Vec2 force, Vec2 mean_force, Vec2 tug_position);
   /// Rewrites /engine's attributes (engines report measured figures, e.g. out-of-plane drift).
@@ -51,6 +54,7 @@ class Recorder {
   const std::string& partial_path() const { return partial_path_; }
   std::int64_t frames() const;
   std::int64_t contact_rows() const;
+  std::int64_t collision_rows() const;
 
  private:
   struct Impl;

@@ -81,6 +81,14 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   if (tow.active()) recorder.write_tow({nan, nan}, {nan, nan}, tow.tug_position(0.0));  // no step yet
   recorder.write_frame(0.0, stepper.state());
+  CollisionTracker collisions(scene);
+  std::vector<CollisionRow> ended;
+  auto record_collisions = [&] {
+    for (const CollisionRow& r : ended) summary.max_peak_force = std::max(summary.max_peak_force, r.peak_force);
+    summary.collision_events += static_cast<std::int64_t>(ended.size());
+    recorder.write_collisions(ended);
+    ended.clear();
+  };
   Progress progress(options.progress);
   for (std::int64_t k = 1; k <= steps; ++k) {
     stepper.step();
@@ -93,6 +101,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     for (const ContactRecord& c : contacts)
       ++(c.kind == ContactKind::collision ? summary.collision_impulses : summary.resting_impulses);
     recorder.write_contacts(t_end, contacts);
+    collisions.observe(t_end, contacts, state, ended);
+    if (!ended.empty()) record_collisions();
     if (k % scene.run.output_every == 0 || k == steps) {
       if (tow.active()) recorder.write_tow(tow.force(), tow.take_mean(), tow.tug_position(t_end));
       recorder.write_frame(t_end, state);
@@ -100,6 +110,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     progress.update(k, steps);
   }
   progress.done();
+  collisions.finish(ended);
+  record_collisions();
   const BodyStates& state = stepper.state();
   summary.steps = steps;
   summary.kinetic_energy_end = kinetic_energy(scene, state);
@@ -112,7 +124,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                    {"kinetic_energy_start", summary.kinetic_energy_start},
                    {"kinetic_energy_end", summary.kinetic_energy_end},
                    {"collision_impulses", static_cast<double>(summary.collision_impulses)},
-                   {"resting_impulses", static_cast<double>(summary.resting_impulses)}});
+                   {"resting_impulses", static_cast<double>(summary.resting_impulses)},
+                   {"collision_events", static_cast<double>(summary.collision_events)},
+                   {"max_peak_force", summary.max_peak_force}});
   return summary;
 }
 
@@ -125,6 +139,7 @@ std::string format_summary(const Scene& scene, const RunSummary& s, const std::s
                 "  bodies      %zu (%zu fixed)\n"
                 "  steps       %lld (dt %g s, %g s of model time), %lld frames recorded\n"
                 "  impulses    %lld collision, %lld resting (%lld contact rows recorded)\n"
+                "  collisions  %lld events, largest estimated peak force %.4g N\n"
                 "  kinetic energy %.6g J -> %.6g J; fastest body %.4g m/s\n"
                 "  wall time   %.3f s (%.4f ms per step)\n"
                 "  output      %s\n",
@@ -132,6 +147,7 @@ std::string format_summary(const Scene& scene, const RunSummary& s, const std::s
                 static_cast<long long>(s.steps), scene.run.dt, static_cast<double>(s.steps) * scene.run.dt,
                 static_cast<long long>(s.frames), static_cast<long long>(s.collision_impulses),
                 static_cast<long long>(s.resting_impulses), static_cast<long long>(s.contact_rows),
+                static_cast<long long>(s.collision_events), s.max_peak_force,
                 s.kinetic_energy_start, s.kinetic_energy_end, s.max_speed, s.wall_seconds,
                 1e3 * s.wall_seconds / static_cast<double>(std::max<std::int64_t>(s.steps, 1)), output.c_str());
   return buf;

@@ -30,6 +30,8 @@ struct RunSummary {
   std::int64_t collision_impulses = 0;
   std::int64_t resting_impulses = 0;
   std::int64_t contact_rows = 0;
+  std::int64_t collision_events = 0;  ///< rows of /contacts/collisions
+  double max_peak_force = 0.0;        ///< N, largest estimated collision peak force
   double kinetic_energy_start = 0.0;  ///< J, translational + rotational, moving bodies
   double kinetic_energy_end = 0.0;
   double max_speed = 0.0;             ///< m/s, largest centroid speed at the end

@@ -123,6 +123,13 @@ void read_contact(TableReader& root, Scene& scene) {
   scene.contact.friction = r.real("friction", scene.contact.friction, Range::non_negative());
   scene.contact.collision_threshold =
       r.real("collision_threshold", scene.contact.collision_threshold, Range::non_negative());
+  // The collision duration: C_tau directly, or a linear contact stiffness k (C_tau = pi / sqrt(k)).
+  if (r.has("duration_coefficient") && r.has("stiffness"))
+    r.fail("stiffness", "give duration_coefficient or stiffness, not both (C_tau = pi / sqrt(k))");
+  scene.contact.duration_coefficient =
+      r.real("duration_coefficient", scene.contact.duration_coefficient, Range::positive());
+  if (r.has("stiffness"))
+    scene.contact.duration_coefficient = M_PI / std::sqrt(r.real("stiffness", std::nullopt, Range::positive()));
   r.reject_unknown();
 }
 

@@ -95,6 +95,18 @@ TEST_CASE("output layout: bodies, frames, contacts, attributes", "[output]") {
     CHECK(shape(f.openDataSet(std::string("/contacts/") + name)) == std::vector<hsize_t>{rows});
   CHECK(shape(f.openDataSet("/contacts/point")) == std::vector<hsize_t>{rows, 2});
   CHECK(shape(f.openDataSet("/contacts/normal")) == std::vector<hsize_t>{rows, 2});
+  // Collision events: one row each, every column the same length, forces from the impulse.
+  const hsize_t events = shape(f.openDataSet("/contacts/collisions/time"))[0];
+  CHECK(events == static_cast<hsize_t>(sum.collision_events));
+  CHECK(events >= 1);
+  for (const char* name : {"body_a", "body_b", "normal_impulse", "effective_mass", "approach_speed",
+                           "restitution_achieved", "duration", "mean_force", "peak_force"})
+    CHECK(shape(f.openDataSet(std::string("/contacts/collisions/") + name)) == std::vector<hsize_t>{events});
+  std::vector<double> impulse(events), duration(events), mean(events);
+  f.openDataSet("/contacts/collisions/normal_impulse").read(impulse.data(), H5::PredType::NATIVE_DOUBLE);
+  f.openDataSet("/contacts/collisions/duration").read(duration.data(), H5::PredType::NATIVE_DOUBLE);
+  f.openDataSet("/contacts/collisions/mean_force").read(mean.data(), H5::PredType::NATIVE_DOUBLE);
+  CHECK(mean[0] == Approx(impulse[0] / duration[0]).epsilon(1e-15));
   fs::remove_all(dir);
 }
 

@@ -1,0 +1,106 @@
+#include "contacts/collision_forces.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace floedem {
+
+double collision_duration(double duration_coefficient, double m_eff) { return duration_coefficient * std::sqrt(m_eff); }
+double collision_mean_force(double impulse, double duration) { return impulse / duration; }
+double collision_peak_force(double impulse, double duration) { return std::numbers::pi * impulse / (2.0 * duration); }
+
+double effective_mass(Vec2 n, Vec2 r_a, double inv_mass_a, double inv_inertia_a, Vec2 r_b, double inv_mass_b,
+                      double inv_inertia_b) {
+  const double ra = cross(r_a, n), rb = cross(r_b, n);
+  const double k = inv_mass_a + ra * ra * inv_inertia_a + inv_mass_b + rb * rb * inv_inertia_b;
+  return k > 0.0 ? 1.0 / k : 0.0;
+}
+
+CollisionTracker::CollisionTracker(const Scene& scene)
+    : c_tau_(scene.contact.duration_coefficient), dt_(scene.run.dt) {
+  const std::size_t n = scene.bodies.size();
+  inv_mass_.resize(n);
+  inv_inertia_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    // The masses the engines see (added mass included when the scene says so).
+    const bool moves = !scene.bodies[i].fixed && !scene.bodies[i].prescribed;
+    inv_mass_[i] = moves ? 1.0 / scene.engine_mass(i) : 0.0;
+    inv_inertia_[i] = moves ? 1.0 / scene.engine_inertia(i) : 0.0;
+  }
+}
+
+CollisionRow CollisionTracker::open_row(double t_end, const StepPair& p, const BodyStates& after) const {
+  CollisionRow row;
+  row.time = t_end;
+  row.body_a = p.a;
+  row.body_b = p.b;
+  const auto a = static_cast<std::size_t>(p.a), b = static_cast<std::size_t>(p.b);
+  // Impulse-weighted point, normal and approach speed over the impact step's collision points.
+  const Vec2 point = (1.0 / p.collision_impulse) * p.weighted_point;
+  const Vec2 normal = normalized(p.weighted_normal);
+  const double approach = p.weighted_approach / p.collision_impulse;
+  // Centroids at the start of the step: x - dt v after it (exact for symplectic Euler, the
+  // native scheme; O(dt^2) for the references). The contact points are from the step's start.
+  const Vec2 xa = after.position[a] - dt_ * after.velocity[a];
+  const Vec2 xb = after.position[b] - dt_ * after.velocity[b];
+  const Vec2 ra = point - xa, rb = point - xb;
+  row.effective_mass = effective_mass(normal, ra, inv_mass_[a], inv_inertia_[a], rb, inv_mass_[b], inv_inertia_[b]);
+  row.approach_speed = approach;
+  // Separation speed after the step at the same material points (the turn of the lever arms
+  // within the step is second order in dt w: neglected).
+  const Vec2 va = after.velocity[a] + cross(after.angular_velocity[a], ra);
+  const Vec2 vb = after.velocity[b] + cross(after.angular_velocity[b], rb);
+  row.restitution_achieved = approach > 0.0 ? dot(vb - va, normal) / approach : 0.0;
+  return row;
+}
+
+void CollisionTracker::observe(double t_end, std::span<const ContactRecord> contacts, const BodyStates& after,
+                               std::vector<CollisionRow>& finished) {
+  ++step_;
+  // This step's contacts summed by pair (a pair's points need not be adjacent in the list:
+  // concave bodies are several convex parts).
+  step_pairs_.clear();
+  for (const ContactRecord& c : contacts) {
+    StepPair& p = step_pairs_[{c.body_a, c.body_b}];
+    p.a = c.body_a;
+    p.b = c.body_b;
+    if (c.kind != ContactKind::collision || !(c.normal_impulse > 0.0)) continue;
+    p.collision_impulse += c.normal_impulse;
+    p.weighted_point += c.normal_impulse * c.point;
+    p.weighted_normal += c.normal_impulse * c.normal;
+    p.weighted_approach += c.normal_impulse * -c.approach_velocity;
+  }
+  for (const auto& [key, p] : step_pairs_) {
+    auto it = open_.find(key);
+    if (it == open_.end()) {
+      if (!(p.collision_impulse > 0.0)) continue;  // resting contact only: no event
+      it = open_.emplace(key, Event{open_row(t_end, p, after), step_}).first;
+    }
+    it->second.row.normal_impulse += p.collision_impulse;
+    it->second.last_step = step_;
+  }
+  // Pairs with no contact this step have separated: their events end.
+  for (auto it = open_.begin(); it != open_.end();) {
+    if (it->second.last_step == step_) {
+      ++it;
+      continue;
+    }
+    finished.push_back(complete(it->second.row));
+    it = open_.erase(it);
+  }
+}
+
+CollisionRow CollisionTracker::complete(CollisionRow row) const {
+  row.duration = collision_duration(c_tau_, row.effective_mass);
+  row.mean_force = collision_mean_force(row.normal_impulse, row.duration);
+  row.peak_force = collision_peak_force(row.normal_impulse, row.duration);
+  return row;
+}
+
+void CollisionTracker::finish(std::vector<CollisionRow>& finished) {
+  for (const auto& [key, event] : open_) finished.push_back(complete(event.row));
+  open_.clear();
+}
+
+}  // namespace floedem

@@ -1,0 +1,83 @@
+#pragma once
+// Collision forces from impulses (MODEL.md section 4; the paper's central proposal).
+//
+// The solver resolves a collision within one step, but a real one lasts longer: about
+//   tau = C_tau sqrt(m_eff),   m_eff = 1 / (n . M^-1 n)
+// at the contact point (rotation included: m_eff = 1 / (1/m_a + (r_a x n)^2 / I_a + 1/m_b +
+// (r_b x n)^2 / I_b), the reduced mass m_a m_b / (m_a + m_b) for a head-on hit). This is what a
+// linear contact spring of stiffness k gives: a half-sine pulse of duration pi sqrt(m_eff / k),
+// so C_tau = pi / sqrt(k). From the collision impulse J the force over the pulse is
+//   mean force  J / tau,      peak force  pi J / (2 tau)   (half-sine: integral = 2 F tau / pi).
+// A resting contact's force is its impulse divided by dt (not tracked here).
+//
+// A collision event is one pair of bodies from the step of first impact to the first step in
+// which the pair has no contact (separation), possibly several points and steps: J adds up the
+// collision impulses of the event; m_eff, approach speed and restitution are those of the impact
+// step, at the impulse-weighted contact point. Engine-neutral: it reads the ContactRecords every
+// engine reports.
+#include <cstdint>
+#include <map>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "engine/engine.hpp"
+#include "scene/scene.hpp"
+
+namespace floedem {
+
+struct CollisionRow {
+  double time = 0.0;                  ///< s, end of the impact step
+  std::int32_t body_a = 0, body_b = 0;///< a < b
+  double normal_impulse = 0.0;        ///< N s, J: the event's collision impulses added up
+  double effective_mass = 0.0;        ///< kg, m_eff along the normal at the contact point
+  double approach_speed = 0.0;        ///< m/s, normal closing speed before impact (> 0)
+  double restitution_achieved = 0.0;  ///< normal separation speed after the impact step / approach speed
+  double duration = 0.0;              ///< s, tau = C_tau sqrt(m_eff)
+  double mean_force = 0.0;            ///< N, J / tau
+  double peak_force = 0.0;            ///< N, pi J / (2 tau)
+};
+
+/// MODEL.md 4: the half-sine pulse of a linear spring.
+double collision_duration(double duration_coefficient, double effective_mass);
+double collision_mean_force(double impulse, double duration);
+double collision_peak_force(double impulse, double duration);
+
+/// m_eff = 1 / (n . M^-1 n) at a point; inverse mass and inertia 0 for a fixed body.
+double effective_mass(Vec2 normal, Vec2 r_a, double inv_mass_a, double inv_inertia_a, Vec2 r_b, double inv_mass_b,
+                      double inv_inertia_b);
+
+class CollisionTracker {
+ public:
+  explicit CollisionTracker(const Scene& scene);
+
+  /// After each step: that step's contacts and the state after it. Events that ended (their
+  /// pair had no contact this step) are appended to `finished`, in pair order.
+  void observe(double t_end, std::span<const ContactRecord> contacts, const BodyStates& after,
+               std::vector<CollisionRow>& finished);
+  /// At the end of the run: the events still open, in pair order.
+  void finish(std::vector<CollisionRow>& finished);
+
+ private:
+  struct Event {
+    CollisionRow row;
+    std::int64_t last_step = 0;
+  };
+  struct StepPair {
+    std::int32_t a = 0, b = 0;
+    double collision_impulse = 0.0;  ///< N s, this step's collision impulses
+    Vec2 weighted_point, weighted_normal;
+    double weighted_approach = 0.0;
+  };
+  using PairKey = std::pair<std::int32_t, std::int32_t>;
+  CollisionRow open_row(double t_end, const StepPair& pair, const BodyStates& after) const;
+  CollisionRow complete(CollisionRow row) const;  ///< duration and forces from J and m_eff
+
+  std::vector<double> inv_mass_, inv_inertia_;
+  double c_tau_ = 0.0, dt_ = 0.0;
+  std::int64_t step_ = 0;
+  std::map<PairKey, Event> open_;
+  std::map<PairKey, StepPair> step_pairs_;
+};
+
+}  // namespace floedem
