@@ -17,8 +17,23 @@ double effective_mass(Vec2 n, Vec2 r_a, double inv_mass_a, double inv_inertia_a,
   return k > 0.0 ? 1.0 / k : 0.0;
 }
 
-CollisionTracker::CollisionTracker(const Scene& scene)
-    : c_tau_(scene.contact.duration_coefficient), dt_(scene.run.dt) {
+DurationModel duration_model_of(const EngineInfo& engine) {
+  const auto it = engine.settings.find("contact_model");
+  return it != engine.settings.end() && it->second == "compliant" ? DurationModel::measured : DurationModel::estimated;
+}
+
+const char* describe(DurationModel model) {
+  return model == DurationModel::measured
+             ? "measured on a compliant contact: first to last step with contact force; peak = largest step "
+               "impulse / dt; mean = J / duration"
+             : "estimated from the impulse: tau = duration_coefficient sqrt(effective_mass) (MODEL.md 4)";
+}
+
+CollisionTracker::CollisionTracker(const Scene& scene, DurationModel model)
+    : c_tau_(scene.contact.duration_coefficient),
+      dt_(scene.run.dt),
+      threshold_(scene.contact.collision_threshold),
+      model_(model) {
   const std::size_t n = scene.bodies.size();
   inv_mass_.resize(n);
   inv_inertia_.resize(n);
@@ -55,6 +70,20 @@ CollisionRow CollisionTracker::open_row(double t_end, const StepPair& p, const B
   return row;
 }
 
+CollisionTracker::Event CollisionTracker::open_event(double t_end, const StepPair& p, const BodyStates& after) const {
+  Event e;
+  e.row = open_row(t_end, p, after);
+  e.first_step = e.last_step = step_;
+  if (model_ == DurationModel::measured) {
+    const auto a = static_cast<std::size_t>(p.a), b = static_cast<std::size_t>(p.b);
+    const Vec2 point = (1.0 / p.collision_impulse) * p.weighted_point;
+    e.normal = normalized(p.weighted_normal);
+    e.local_a = Rot::from_angle(after.angle[a]).apply_inverse(point - after.position[a]);
+    e.local_b = Rot::from_angle(after.angle[b]).apply_inverse(point - after.position[b]);
+  }
+  return e;
+}
+
 void CollisionTracker::observe(double t_end, std::span<const ContactRecord> contacts, const BodyStates& after,
                                std::vector<CollisionRow>& finished) {
   ++step_;
@@ -65,7 +94,12 @@ void CollisionTracker::observe(double t_end, std::span<const ContactRecord> cont
     StepPair& p = step_pairs_[{c.body_a, c.body_b}];
     p.a = c.body_a;
     p.b = c.body_b;
-    if (c.kind != ContactKind::collision || !(c.normal_impulse > 0.0)) continue;
+    if (c.normal_impulse > 0.0) p.impulse += c.normal_impulse;
+    // What starts an event: an impulse at a point approaching faster than the threshold
+    // (the engines' collision kind; a compliant engine's records say the same).
+    const bool impact = model_ == DurationModel::estimated ? c.kind == ContactKind::collision
+                                                           : -c.approach_velocity > threshold_;
+    if (!impact || !(c.normal_impulse > 0.0)) continue;
     p.collision_impulse += c.normal_impulse;
     p.weighted_point += c.normal_impulse * c.point;
     p.weighted_normal += c.normal_impulse * c.normal;
@@ -75,31 +109,50 @@ void CollisionTracker::observe(double t_end, std::span<const ContactRecord> cont
     auto it = open_.find(key);
     if (it == open_.end()) {
       if (!(p.collision_impulse > 0.0)) continue;  // resting contact only: no event
-      it = open_.emplace(key, Event{open_row(t_end, p, after), step_}).first;
+      it = open_.emplace(key, open_event(t_end, p, after)).first;
     }
-    it->second.row.normal_impulse += p.collision_impulse;
-    it->second.last_step = step_;
+    Event& e = it->second;
+    if (model_ == DurationModel::estimated) {
+      e.row.normal_impulse += p.collision_impulse;
+    } else {
+      e.row.normal_impulse += p.impulse;
+      e.peak_step_impulse = std::max(e.peak_step_impulse, p.impulse);
+    }
+    if (p.impulse > 0.0) e.last_step = step_;
   }
-  // Pairs with no contact this step have separated: their events end.
+  // Pairs with no contact force this step have separated: their events end.
   for (auto it = open_.begin(); it != open_.end();) {
     if (it->second.last_step == step_) {
       ++it;
       continue;
     }
-    finished.push_back(complete(it->second.row));
+    finished.push_back(complete(it->second, after));
     it = open_.erase(it);
   }
 }
 
-CollisionRow CollisionTracker::complete(CollisionRow row) const {
-  row.duration = collision_duration(c_tau_, row.effective_mass);
-  row.mean_force = collision_mean_force(row.normal_impulse, row.duration);
-  row.peak_force = collision_peak_force(row.normal_impulse, row.duration);
+CollisionRow CollisionTracker::complete(const Event& e, const BodyStates& now) const {
+  CollisionRow row = e.row;
+  if (model_ == DurationModel::estimated) {
+    row.duration = collision_duration(c_tau_, row.effective_mass);
+    row.mean_force = collision_mean_force(row.normal_impulse, row.duration);
+    row.peak_force = collision_peak_force(row.normal_impulse, row.duration);
+    return row;
+  }
+  row.duration = static_cast<double>(e.last_step - e.first_step + 1) * dt_;
+  row.mean_force = row.normal_impulse / row.duration;
+  row.peak_force = e.peak_step_impulse / dt_;
+  // Restitution once separated: the relative normal velocity at the contact's material points.
+  const auto a = static_cast<std::size_t>(row.body_a), b = static_cast<std::size_t>(row.body_b);
+  const Vec2 ra = Rot::from_angle(now.angle[a]).apply(e.local_a), rb = Rot::from_angle(now.angle[b]).apply(e.local_b);
+  const Vec2 va = now.velocity[a] + cross(now.angular_velocity[a], ra);
+  const Vec2 vb = now.velocity[b] + cross(now.angular_velocity[b], rb);
+  row.restitution_achieved = row.approach_speed > 0.0 ? dot(vb - va, e.normal) / row.approach_speed : 0.0;
   return row;
 }
 
-void CollisionTracker::finish(std::vector<CollisionRow>& finished) {
-  for (const auto& [key, event] : open_) finished.push_back(complete(event.row));
+void CollisionTracker::finish(const BodyStates& now, std::vector<CollisionRow>& finished) {
+  for (const auto& [key, event] : open_) finished.push_back(complete(event, now));
   open_.clear();
 }
 

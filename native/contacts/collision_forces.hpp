@@ -47,34 +47,50 @@ double collision_peak_force(double impulse, double duration);
 double effective_mass(Vec2 normal, Vec2 r_a, double inv_mass_a, double inv_inertia_a, Vec2 r_b, double inv_mass_b,
                       double inv_inertia_b);
 
+/// How an event's duration is found: estimated from the impulse (tau = C_tau sqrt(m_eff), for
+/// engines that resolve a collision in one step), or measured (a compliant engine: the steps
+/// from first to last with contact force, the peak of the step forces impulse / dt, J their
+/// sum, the restitution from the relative normal velocity once the pair has separated).
+enum class DurationModel : std::uint8_t { estimated, measured };
+
+/// The model for an engine: measured when its settings say contact_model = "compliant".
+DurationModel duration_model_of(const EngineInfo& engine);
+const char* describe(DurationModel model);
+
 class CollisionTracker {
  public:
-  explicit CollisionTracker(const Scene& scene);
+  explicit CollisionTracker(const Scene& scene, DurationModel model = DurationModel::estimated);
 
   /// After each step: that step's contacts and the state after it. Events that ended (their
   /// pair had no contact this step) are appended to `finished`, in pair order.
   void observe(double t_end, std::span<const ContactRecord> contacts, const BodyStates& after,
                std::vector<CollisionRow>& finished);
   /// At the end of the run: the events still open, in pair order.
-  void finish(std::vector<CollisionRow>& finished);
+  void finish(const BodyStates& now, std::vector<CollisionRow>& finished);
 
  private:
   struct Event {
     CollisionRow row;
-    std::int64_t last_step = 0;
+    std::int64_t first_step = 0, last_step = 0;
+    double peak_step_impulse = 0.0;  ///< measured: the largest step impulse
+    Vec2 normal;                     ///< measured: for the restitution at separation
+    Vec2 local_a, local_b;           ///< measured: the contact point in each body's frame
   };
   struct StepPair {
     std::int32_t a = 0, b = 0;
     double collision_impulse = 0.0;  ///< N s, this step's collision impulses
     Vec2 weighted_point, weighted_normal;
     double weighted_approach = 0.0;
+    double impulse = 0.0;            ///< N s, all this step's normal impulses (measured model)
   };
   using PairKey = std::pair<std::int32_t, std::int32_t>;
   CollisionRow open_row(double t_end, const StepPair& pair, const BodyStates& after) const;
-  CollisionRow complete(CollisionRow row) const;  ///< duration and forces from J and m_eff
+  CollisionRow complete(const Event& event, const BodyStates& now) const;  ///< duration, forces, restitution
+  Event open_event(double t_end, const StepPair& pair, const BodyStates& after) const;
 
   std::vector<double> inv_mass_, inv_inertia_;
-  double c_tau_ = 0.0, dt_ = 0.0;
+  double c_tau_ = 0.0, dt_ = 0.0, threshold_ = 0.0;
+  DurationModel model_ = DurationModel::estimated;
   std::int64_t step_ = 0;
   std::map<PairKey, Event> open_;
   std::map<PairKey, StepPair> step_pairs_;

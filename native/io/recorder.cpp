@@ -281,8 +281,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     {
       H5::Group events = d.file.createGroup("/contacts/collisions");
       write_attribute(events, "duration_coefficient", scene.contact.duration_coefficient);
-      write_attribute(events, "duration_model",
-                      "estimated from the impulse: tau = duration_coefficient sqrt(effective_mass) (MODEL.md 4)");
+      write_attribute(events, "duration_model", describe(duration_model_of(engine)));
       constexpr hsize_t ke = 1024;
       d.e_time = Series(events, "time", H5::PredType::NATIVE_DOUBLE, {}, ke);
       d.e_body_a = Series(events, "body_a", H5::PredType::NATIVE_INT32, {}, ke);

@@ -81,7 +81,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   if (tow.active()) recorder.write_tow({nan, nan}, {nan, nan}, tow.tug_position(0.0));  // no step yet
   recorder.write_frame(0.0, stepper.state());
-  CollisionTracker collisions(scene);
+  CollisionTracker collisions(scene, duration_model_of(stepper.engine().info()));
   std::vector<CollisionRow> ended;
   auto record_collisions = [&] {
     for (const CollisionRow& r : ended) summary.max_peak_force = std::max(summary.max_peak_force, r.peak_force);
@@ -110,7 +110,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     progress.update(k, steps);
   }
   progress.done();
-  collisions.finish(ended);
+  collisions.finish(stepper.state(), ended);
   record_collisions();
   const BodyStates& state = stepper.state();
   summary.steps = steps;
@@ -139,7 +139,7 @@ std::string format_summary(const Scene& scene, const RunSummary& s, const std::s
                 "  bodies      %zu (%zu fixed)\n"
                 "  steps       %lld (dt %g s, %g s of model time), %lld frames recorded\n"
                 "  impulses    %lld collision, %lld resting (%lld contact rows recorded)\n"
-                "  collisions  %lld events, largest estimated peak force %.4g N\n"
+                "  collisions  %lld events, largest peak force %.4g N\n"
                 "  kinetic energy %.6g J -> %.6g J; fastest body %.4g m/s\n"
                 "  wall time   %.3f s (%.4f ms per step)\n"
                 "  output      %s\n",

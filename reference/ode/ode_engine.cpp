@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <mutex>
 
+#include "contacts/collision_forces.hpp"
 #include "scenario/table_reader.hpp"
 #include "solver/broad_phase.hpp"
 #include "solver/part_set.hpp"
@@ -37,6 +38,10 @@ struct OdeSettings {
   double cfm = 1e-16;
   double erp = 0.2;
   double max_correcting_velocity = 0.01;  ///< m/s
+  /// "impulse" (Newton restitution, the default) or "compliant": each contact a linear spring
+  /// k = (pi / C_tau)^2 with a dashpot of damping ratio zeta from the restitution (below), as
+  /// ODE's soft ERP/CFM, so that collisions last and their duration can be measured.
+  bool compliant = false;
 };
 
 OdeSettings read_settings(const Scene& scene) {
@@ -49,6 +54,7 @@ OdeSettings read_settings(const Scene& scene) {
   s.cfm = r.real("cfm", s.cfm, Range::non_negative());
   s.erp = r.real("erp", s.erp, Range::closed(0.0, 1.0));
   s.max_correcting_velocity = r.real("max_correcting_velocity", s.max_correcting_velocity, Range::non_negative());
+  s.compliant = r.string("contact_model", "impulse", {"impulse", "compliant"}) == "compliant";
   r.reject_unknown();
   return s;
 }
@@ -87,6 +93,9 @@ class OdeEngine final : public Engine {
   std::vector<ContactRecord> records_;
   BodyStates state_;
   double max_out_of_plane_ = 0.0;
+  std::vector<double> inv_mass_, inv_inertia_;
+  double stiffness_ = 0.0;     ///< N/m, compliant contact spring of a pair
+  double damping_ratio_ = 0.0; ///< zeta of the compliant contact
 };
 
 OdeEngine::OdeEngine(const Scene& scene)
@@ -97,14 +106,24 @@ OdeEngine::OdeEngine(const Scene& scene)
   dWorldSetGravity(world_, 0, 0, 0);
   dWorldSetCFM(world_, settings_.cfm);
   dWorldSetERP(world_, settings_.erp);
-  dWorldSetContactMaxCorrectingVel(world_, settings_.max_correcting_velocity);
+  // A compliant contact is all correction: its spring must not be capped.
+  dWorldSetContactMaxCorrectingVel(world_, settings_.compliant ? dInfinity : settings_.max_correcting_velocity);
   dWorldSetQuickStepNumIterations(world_, settings_.iterations);
+  // Compliant contact (MODEL.md 4): k from the same C_tau as native's estimate, C_tau = pi / sqrt(k);
+  // zeta from the restitution of an undamped-in-separation spring-dashpot,
+  // e = exp(-zeta pi / sqrt(1 - zeta^2))  <=>  zeta = -ln e / sqrt(pi^2 + ln^2 e) (e = 0: critical).
+  stiffness_ = std::pow(M_PI / contact_.duration_coefficient, 2);
+  const double log_e = std::log(contact_.restitution);
+  damping_ratio_ = contact_.restitution > 0.0 ? -log_e / std::sqrt(M_PI * M_PI + log_e * log_e) : 1.0;
   dWorldSetAutoDisableFlag(world_, 0);
   contact_group_ = dJointGroupCreate(0);
   const std::size_t n = scene.bodies.size();
   for (std::size_t i = 0; i < n; ++i) {
     const BodySpec& b = scene.bodies[i];
     fixed_position_.push_back(b.centroid);
+    const bool moves = !b.fixed && !b.prescribed;
+    inv_mass_.push_back(moves ? 1.0 / scene.engine_mass(i) : 0.0);
+    inv_inertia_.push_back(moves ? 1.0 / scene.engine_inertia(i) : 0.0);
     if (b.fixed) {
       bodies_.push_back(nullptr);
       continue;
@@ -145,9 +164,14 @@ EngineInfo OdeEngine::info() const {
                 {"cfm", setting_text(settings_.cfm)},
                 {"erp", setting_text(settings_.erp)},
                 {"max_correcting_velocity", setting_text(settings_.max_correcting_velocity)},
+                {"contact_model", settings_.compliant ? "compliant" : "impulse"},
                 {"friction", "dContactApprox1, in-plane tangent only"},
                 {"contact_geometry", "floedem 2-D narrow phase"},
                 {"max_out_of_plane", setting_text(max_out_of_plane_)}};
+  if (settings_.compliant) {
+    i.settings["contact_stiffness"] = setting_text(stiffness_);
+    i.settings["contact_damping_ratio"] = setting_text(damping_ratio_);
+  }
   i.limitations = {"contact points from floedem's 2-D narrow phase, not ODE's colliders (one point per step for convex prisms)",
                    "contacts found only once bodies touch (no speculative contact): impacts resolve after up to v dt of overlap"};
   return i;
@@ -177,6 +201,22 @@ void OdeEngine::step(const Loads* loads) {
       c.surface.bounce = contact_.restitution;
       c.surface.bounce_vel = contact_.collision_threshold;
       c.surface.soft_cfm = settings_.cfm;
+      if (settings_.compliant) {
+        // Spring k and dashpot c shared by the manifold's points; ODE's implicit spring-damper:
+        // ERP = h k / (h k + c), CFM = 1 / (h k + c) (ODE manual, "Soft constraint and
+        // constraint force mixing"). c = 2 zeta sqrt(k m_eff), m_eff of the pair along the
+        // normal at the middle of the manifold (at a corner point it would count the turn that
+        // the other point's spring prevents: for a face contact 0.4 m instead of m).
+        const double share = 1.0 / m.point_count;
+        Vec2 middle;
+        for (int q = 0; q < m.point_count; ++q) middle += share * m.points[q].point;
+        const double m_eff = effective_mass(m.normal, middle - state_.position[a], inv_mass_[a], inv_inertia_[a],
+                                            middle - state_.position[b], inv_mass_[b], inv_inertia_[b]);
+        const double k = share * stiffness_, damping = share * 2.0 * damping_ratio_ * std::sqrt(stiffness_ * m_eff);
+        c.surface.mode = dContactSoftERP | dContactSoftCFM | dContactApprox1 | dContactFDir1 | dContactMu2;
+        c.surface.soft_erp = dt_ * k / (dt_ * k + damping);
+        c.surface.soft_cfm = 1.0 / (dt_ * k + damping);
+      }
       // ODE: moving body 1 along the normal by depth separates the bodies.
       const Vec2 normal = b_is_body1 ? m.normal : -m.normal;
       c.geom.pos[0] = p.point.x;

@@ -30,7 +30,7 @@ std::vector<CollisionRow> events_of(const Scene& s) {
     stepper.step();
     tracker.observe(stepper.time(), stepper.contacts(), stepper.state(), rows);
   }
-  tracker.finish(rows);
+  tracker.finish(stepper.state(), rows);
   return rows;
 }
 
