@@ -17,6 +17,14 @@ double effective_mass(Vec2 n, Vec2 r_a, double inv_mass_a, double inv_inertia_a,
   return k > 0.0 ? 1.0 / k : 0.0;
 }
 
+CompliantContact compliant_contact(const ContactSettings& contact) {
+  CompliantContact c;
+  c.stiffness = std::pow(std::numbers::pi / contact.duration_coefficient, 2);
+  const double log_e = std::log(contact.restitution);
+  c.damping_ratio = contact.restitution > 0.0 ? -log_e / std::sqrt(std::numbers::pi * std::numbers::pi + log_e * log_e) : 1.0;
+  return c;
+}
+
 DurationModel duration_model_of(const EngineInfo& engine) {
   const auto it = engine.settings.find("contact_model");
   return it != engine.settings.end() && it->second == "compliant" ? DurationModel::measured : DurationModel::estimated;

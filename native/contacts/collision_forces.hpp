@@ -57,6 +57,16 @@ enum class DurationModel : std::uint8_t { estimated, measured };
 DurationModel duration_model_of(const EngineInfo& engine);
 const char* describe(DurationModel model);
 
+/// The compliant contact the reference engines use for measured durations (MODEL.md 4): a
+/// linear spring k = (pi / C_tau)^2, so that its undamped half-sine lasts native's estimate
+/// C_tau sqrt(m_eff), and a dashpot c = 2 zeta sqrt(k m_eff) with zeta from the restitution,
+/// e = exp(-zeta pi / sqrt(1 - zeta^2)) <=> zeta = -ln e / sqrt(pi^2 + ln^2 e) (e = 0: zeta = 1).
+struct CompliantContact {
+  double stiffness = 0.0;      ///< N/m
+  double damping_ratio = 0.0;  ///< zeta
+};
+CompliantContact compliant_contact(const ContactSettings& contact);
+
 class CollisionTracker {
  public:
   explicit CollisionTracker(const Scene& scene, DurationModel model = DurationModel::estimated);

@@ -22,7 +22,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
+#include "contacts/collision_forces.hpp"
 #include "geometry/polygon.hpp"
 #include "scenario/table_reader.hpp"
 
@@ -33,6 +35,11 @@ namespace {
 struct BulletSettings {
   int iterations = 50;
   double margin = 0.01;  ///< m, collision margin
+  /// "impulse" (restitution, the default) or "compliant": each contact a linear spring
+  /// k = (pi / C_tau)^2 with a dashpot of damping ratio zeta(e), through Bullet's contact
+  /// stiffness and damping (CFM = 1 / (dt k + c), ERP = dt k / (dt k + c)), split impulse off
+  /// (it would turn the spring's push into a position correction without momentum).
+  bool compliant = false;
 };
 
 BulletSettings read_settings(const Scene& scene) {
@@ -42,6 +49,7 @@ BulletSettings read_settings(const Scene& scene) {
   TableReader r(it->second, scene.source_path, "engine.bullet");
   s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
   s.margin = r.real("margin", s.margin, Range::positive());
+  s.compliant = r.string("contact_model", "impulse", {"impulse", "compliant"}) == "compliant";
   r.reject_unknown();
   return s;
 }
@@ -52,6 +60,18 @@ btScalar combined_restitution(const btCollisionObject* a, const btCollisionObjec
 btScalar combined_friction(const btCollisionObject* a, const btCollisionObject* b) {
   return std::min(a->getFriction(), b->getFriction());
 }
+
+/// The dynamics world with a hook between collision detection and the solver (where the
+/// compliant model sets each contact point's spring and dashpot).
+class PlanarWorld final : public btDiscreteDynamicsWorld {
+ public:
+  using btDiscreteDynamicsWorld::btDiscreteDynamicsWorld;
+  std::function<void()> before_solve;
+  void solveConstraints(btContactSolverInfo& info) override {
+    if (before_solve) before_solve();
+    btDiscreteDynamicsWorld::solveConstraints(info);
+  }
+};
 
 class BulletEngine final : public Engine {
  public:
@@ -65,6 +85,7 @@ class BulletEngine final : public Engine {
  private:
   void publish();
   void collect_contacts();
+  void set_compliance();
 
   BulletSettings settings_;
   double dt_;
@@ -74,7 +95,7 @@ class BulletEngine final : public Engine {
   btCollisionDispatcher dispatcher_{&configuration_};
   btDbvtBroadphase broadphase_;
   btSequentialImpulseConstraintSolver solver_;
-  btDiscreteDynamicsWorld world_{&dispatcher_, &broadphase_, &solver_, &configuration_};
+  PlanarWorld world_{&dispatcher_, &broadphase_, &solver_, &configuration_};
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btDefaultMotionState>> motion_states_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
@@ -82,6 +103,8 @@ class BulletEngine final : public Engine {
   BodyStates state_, before_;
   std::vector<ContactRecord> records_;
   double max_out_of_plane_ = 0.0;  // m and rad, over the run
+  std::vector<double> inv_mass_, inv_inertia_;
+  double stiffness_ = 0.0, damping_ratio_ = 0.0;  // compliant contact of a pair
 };
 
 BulletEngine::BulletEngine(const Scene& scene)
@@ -91,8 +114,15 @@ BulletEngine::BulletEngine(const Scene& scene)
   world_.setGravity(btVector3(0, 0, 0));
   btContactSolverInfo& info = world_.getSolverInfo();
   info.m_numIterations = settings_.iterations;
-  info.m_splitImpulse = 1;
+  info.m_splitImpulse = settings_.compliant ? 0 : 1;
   info.m_splitImpulsePenetrationThreshold = 0;
+  if (settings_.compliant) {
+    // The same spring as ODE's compliant model and native's estimate (contacts/collision_forces.hpp).
+    const CompliantContact compliant = compliant_contact(scene.contact);
+    stiffness_ = compliant.stiffness;
+    damping_ratio_ = compliant.damping_ratio;
+    world_.before_solve = [this] { set_compliance(); };
+  }
   info.m_restitutionVelocityThreshold = threshold_;
 
   // Taller than any overlap can get: four times the largest body.
@@ -132,7 +162,9 @@ BulletEngine::BulletEngine(const Scene& scene)
     // Only I_zz matters: the angular factor (0, 0, 1) removes the other axes.
     btRigidBody::btRigidBodyConstructionInfo ci(mass, motion_states_.back().get(), shape,
                                                 dynamic ? btVector3(izz, izz, izz) : btVector3(0, 0, 0));
-    ci.m_restitution = scene.contact.restitution;
+    ci.m_restitution = settings_.compliant ? 0.0 : scene.contact.restitution;
+    inv_mass_.push_back(dynamic ? 1.0 / scene.engine_mass(i) : 0.0);
+    inv_inertia_.push_back(dynamic ? 1.0 / izz : 0.0);
     ci.m_friction = scene.contact.friction;
     ci.m_linearDamping = 0;
     ci.m_angularDamping = 0;
@@ -164,10 +196,15 @@ EngineInfo BulletEngine::info() const {
   i.settings = {{"iterations", std::to_string(settings_.iterations)},
                 {"margin", setting_text(settings_.margin)},
                 {"prism_height", setting_text(height_)},
-                {"split_impulse", "on, threshold 0"},
+                {"split_impulse", settings_.compliant ? "off" : "on, threshold 0"},
+                {"contact_model", settings_.compliant ? "compliant" : "impulse"},
                 {"restitution_velocity_threshold", setting_text(threshold_)},
                 {"combine", "restitution max, friction min"},
                 {"max_out_of_plane", setting_text(max_out_of_plane_)}};
+  if (settings_.compliant) {
+    i.settings["contact_stiffness"] = setting_text(stiffness_);
+    i.settings["contact_damping_ratio"] = setting_text(damping_ratio_);
+  }
   i.limitations = {"bodies are prisms held in the plane by linear and angular factors",
                    "up to 4 contact points per pair, top and bottom of the prism (compare impulses summed per pair)"};
   return i;
@@ -193,6 +230,42 @@ void BulletEngine::step(const Loads* loads) {
   world_.stepSimulation(dt_, 0);
   publish();
   collect_contacts();
+}
+
+void BulletEngine::set_compliance() {
+  // Per pair: spring k and dashpot c = 2 zeta sqrt(k m_eff) shared by its touching points (up
+  // to four: the prism's top and bottom), m_eff along the normal at the points' middle.
+  const int manifolds = dispatcher_.getNumManifolds();
+  for (int k = 0; k < manifolds; ++k) {
+    btPersistentManifold* pm = dispatcher_.getManifoldByIndexInternal(k);
+    const int i0 = pm->getBody0()->getUserIndex(), i1 = pm->getBody1()->getUserIndex();
+    int touching = 0;
+    Vec2 middle;
+    for (int j = 0; j < pm->getNumContacts(); ++j) {
+      const btManifoldPoint& pt = pm->getContactPoint(j);
+      if (pt.getDistance() > 0) continue;
+      const btVector3 p = 0.5 * (pt.getPositionWorldOnA() + pt.getPositionWorldOnB());
+      middle += Vec2{p.x(), p.y()};
+      ++touching;
+    }
+    if (touching == 0) continue;
+    middle = (1.0 / touching) * middle;
+    const auto centre = [&](int i) {
+      const btVector3& c = bodies_[static_cast<std::size_t>(i)]->getCenterOfMassPosition();
+      return Vec2{c.x(), c.y()};
+    };
+    const btVector3& nb = pm->getContactPoint(0).m_normalWorldOnB;
+    const double m_eff = effective_mass({nb.x(), nb.y()}, middle - centre(i0), inv_mass_[static_cast<std::size_t>(i0)],
+                                        inv_inertia_[static_cast<std::size_t>(i0)], middle - centre(i1),
+                                        inv_mass_[static_cast<std::size_t>(i1)], inv_inertia_[static_cast<std::size_t>(i1)]);
+    const double share = 1.0 / touching;
+    for (int j = 0; j < pm->getNumContacts(); ++j) {
+      btManifoldPoint& pt = pm->getContactPoint(j);
+      pt.m_combinedContactStiffness1 = share * stiffness_;
+      pt.m_combinedContactDamping1 = share * 2.0 * damping_ratio_ * std::sqrt(stiffness_ * m_eff);
+      pt.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
+    }
+  }
 }
 
 void BulletEngine::collect_contacts() {

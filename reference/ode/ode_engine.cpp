@@ -109,12 +109,10 @@ OdeEngine::OdeEngine(const Scene& scene)
   // A compliant contact is all correction: its spring must not be capped.
   dWorldSetContactMaxCorrectingVel(world_, settings_.compliant ? dInfinity : settings_.max_correcting_velocity);
   dWorldSetQuickStepNumIterations(world_, settings_.iterations);
-  // Compliant contact (MODEL.md 4): k from the same C_tau as native's estimate, C_tau = pi / sqrt(k);
-  // zeta from the restitution of an undamped-in-separation spring-dashpot,
-  // e = exp(-zeta pi / sqrt(1 - zeta^2))  <=>  zeta = -ln e / sqrt(pi^2 + ln^2 e) (e = 0: critical).
-  stiffness_ = std::pow(M_PI / contact_.duration_coefficient, 2);
-  const double log_e = std::log(contact_.restitution);
-  damping_ratio_ = contact_.restitution > 0.0 ? -log_e / std::sqrt(M_PI * M_PI + log_e * log_e) : 1.0;
+  // Compliant contact (MODEL.md 4): the same spring as native's estimate (contacts/collision_forces.hpp).
+  const CompliantContact compliant = compliant_contact(contact_);
+  stiffness_ = compliant.stiffness;
+  damping_ratio_ = compliant.damping_ratio;
   dWorldSetAutoDisableFlag(world_, 0);
   contact_group_ = dJointGroupCreate(0);
   const std::size_t n = scene.bodies.size();

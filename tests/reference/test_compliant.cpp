@@ -7,7 +7,10 @@
 // (zeta = 0.59) that is 0.741 of the undamped half-sine pi sqrt(m_eff / k), the documented gap
 // between the compliant references and native's estimate. The measured duration counts whole
 // steps from first to last with contact force and ODE's spring-damper is implicit Euler: at
-// dt = tau / 40 it exceeds t_c by 4.6 % (0.4 % at tau / 320). Tolerance 10 % against t_c.
+// dt = tau / 40 it exceeds t_c by 4.6 % (0.4 % at tau / 320); Bullet's the same, except that
+// on the heavy floes (deep overlap, centimetres) its persistent manifold drops and re-adds
+// points during the pulse (4 -> 2 -> 3 points), which tilts the push and delays the release by
+// up to 15 % (measured at h = 100 m). Tolerance against t_c: 10 % for ODE, 20 % for Bullet.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -57,15 +60,17 @@ Measured impact(const std::string& engine, double h, double e) {
 
 }  // namespace
 
-TEST_CASE("compliant ODE: durations follow the spring-dashpot and scale as sqrt(m_eff) over 8 decades",
+TEST_CASE("compliant ODE and Bullet: durations follow the spring-dashpot and scale as sqrt(m_eff) over 8 decades",
           "[reference][compliant]") {
+  for (const std::string engine : {"ode", "bullet"}) {
+  INFO(engine);
   std::vector<double> log_m, log_tau;
   for (int p = -4; p <= 4; p += 2) {
     const double h = std::pow(10.0, p);
-    const Measured r = impact("ode", h, 0.1);
+    const Measured r = impact(engine, h, 0.1);
     INFO("h = " << h << " m: measured " << r.row.duration << " s, t_c " << r.released << " s, pi sqrt(m/k) "
                 << r.undamped << " s, restitution " << r.row.restitution_achieved);
-    CHECK(r.row.duration == Approx(r.released).epsilon(0.10));
+    CHECK(r.row.duration == Approx(r.released).epsilon(engine == "ode" ? 0.10 : 0.20));
     CHECK(r.released / r.undamped == Approx(0.741).epsilon(1e-3));  // the gap, as documented
     CHECK(r.row.effective_mass == Approx(90000.0 * h).epsilon(1e-12));
     // The impulse is momentum exchanged: (1 + e_achieved) m u, whatever e came out as.
@@ -87,4 +92,5 @@ TEST_CASE("compliant ODE: durations follow the spring-dashpot and scale as sqrt(
   }
   const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
   CHECK(slope == Approx(0.5).margin(0.05));
+  }
 }
