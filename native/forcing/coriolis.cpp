@@ -14,6 +14,7 @@ class Coriolis final : public ForceTerm {
       if (!scene.bodies[i].fixed) bodies_.push_back(i);
   }
   std::string_view name() const override { return "coriolis"; }
+  bool constant_rotation_only() const override { return true; }
   void add(const BodyStates&, double, ForceSums& sums) const override {
     for (const std::size_t i : bodies_) sums.rotation_rate[i] += f_;
     sums.any_rotation = true;

@@ -40,6 +40,9 @@ class ForceTerm {
   virtual std::string_view name() const = 0;
   /// Adds this term at the start of a step at `time`.
   virtual void add(const BodyStates& state, double time, ForceSums& sums) const = 0;
+  /// True for a term that only adds a constant rotation rate (Coriolis): a scene whose terms
+  /// are all such takes a precomputed per-body path (Forcing::evaluate).
+  virtual bool constant_rotation_only() const { return false; }
 };
 
 /// Builds the term for a scene, or returns nullptr when the scene does not use it.
@@ -76,6 +79,11 @@ class Forcing {
     double engine_mass = 0.0, engine_inertia = 0.0;
   };
   std::vector<BodyHot> hot_;
+  /// Rotation-only scenes: the load is linear in the velocity, F = alpha k x v... written
+  /// F = alpha (v_y, -v_x) - beta v, with alpha and beta per body for the first step (half
+  /// turn) and the later ones.
+  bool rotation_only_ = false;
+  std::vector<std::array<double, 4>> rotation_coefficients_;  ///< alpha, beta (first step), alpha, beta
 };
 
 // Builders, one per term file.
