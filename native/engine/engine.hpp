@@ -44,6 +44,10 @@ struct Loads {
   std::vector<double> torque;
   bool any = false;  ///< false: every force entry is zero and the engine may skip them
   std::vector<PrescribedMotion> prescribed;
+  /// Empty, or per body a turn of the centroid velocity at the start of the step, before the
+  /// forces: a scene whose only term is Coriolis hands its exact velocity rotation this way
+  /// instead of as forces, so that the engine needs no force pass (forcing.cpp).
+  std::vector<Rot> velocity_turn;
 };
 
 enum class ContactKind : std::uint8_t {

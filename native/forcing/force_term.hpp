@@ -79,11 +79,12 @@ class Forcing {
     double engine_mass = 0.0, engine_inertia = 0.0;
   };
   std::vector<BodyHot> hot_;
-  /// Rotation-only scenes: the load is linear in the velocity, F = alpha k x v... written
-  /// F = alpha (v_y, -v_x) - beta v, with alpha and beta per body for the first step (half
-  /// turn) and the later ones.
+  /// Rotation-only scenes (Coriolis alone): the exact turn of each body's velocity, by
+  /// -f' dt / 2 on the first step (the trapezoidal start) and -f' dt after, handed to the
+  /// engine as Loads::velocity_turn.
   bool rotation_only_ = false;
-  std::vector<std::array<double, 4>> rotation_coefficients_;  ///< alpha, beta (first step), alpha, beta
+  std::vector<Rot> turn_first_, turn_later_;
+  const std::vector<Rot>* turn_handed_ = nullptr;
 };
 
 // Builders, one per term file.

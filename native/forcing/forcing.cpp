@@ -114,11 +114,10 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
     h.engine_mass = scene.engine_mass(i);
     h.engine_inertia = scene.engine_inertia(i);
   }
-  // A scene whose only terms are constant rotations (Coriolis alone): the load of the general
-  // path below with q = 0 and no Jacobian is linear in v, with constant coefficients, so it is
-  // computed once here. dv solves [[M, -c], [c, M]] dv = cv (v_y, -v_x), M = m_I / dt,
-  // c = cv / 2, cv = m_I f~:  dv = cv / det (M v_y - c v_x, -M v_x - c v_y), det = M^2 + c^2,
-  // and F = m_engine dv / dt.
+  // A scene whose only terms are constant rotations (Coriolis alone): with q = 0 and no
+  // Jacobian the general path below is the Cayley rotation of the velocity by exactly
+  // -f' dt (f' = f m / m_I; half of it on the first step), so the engines are handed that
+  // turn instead of forces.
   rotation_only_ = !terms_.empty() && prescribed_.empty() &&
                    std::all_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->constant_rotation_only(); });
   if (rotation_only_) {
@@ -126,18 +125,14 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
     BodyStates none;
     none.resize(n);
     for (const auto& t : terms_) t->add(none, 0.0, sums_);
-    rotation_coefficients_.assign(n, {});
+    turn_first_.assign(n, Rot{});
+    turn_later_.assign(n, Rot{});
     for (std::size_t i = 0; i < n; ++i) {
       const BodyHot& h = hot_[i];
       if (!h.moves) continue;
       const double f = sums_.rotation_rate[i] * h.mass / h.mass_with_added;
-      for (int k = 0; k < 2; ++k) {
-        const double ft = (2.0 / dt_) * std::tan((k == 0 ? 0.25 : 0.5) * f * dt_);  // Cayley-exact rate
-        const double cv = h.mass_with_added * ft, m = h.mass_with_added / dt_, c = 0.5 * cv;
-        const double scale = h.engine_mass / dt_ * cv / (m * m + c * c);
-        rotation_coefficients_[i][2 * k] = scale * m;
-        rotation_coefficients_[i][2 * k + 1] = scale * c;
-      }
+      turn_first_[i] = Rot::from_angle(-0.5 * f * dt_);
+      turn_later_[i] = Rot::from_angle(-f * dt_);
     }
   }
 }
@@ -159,13 +154,11 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
   loads_.any = !terms_.empty();
   if (terms_.empty()) return &loads_;
   if (rotation_only_) {
-    const std::size_t k = time == 0.0 ? 0 : 2;
-    const std::size_t n = hot_.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const double alpha = rotation_coefficients_[i][k], beta = rotation_coefficients_[i][k + 1];
-      const Vec2 v = state.velocity[i];
-      loads_.force[i] = {alpha * v.y - beta * v.x, -alpha * v.x - beta * v.y};
-      loads_.torque[i] = 0.0;
+    loads_.any = false;
+    const std::vector<Rot>& turn = time == 0.0 ? turn_first_ : turn_later_;
+    if (turn_handed_ != &turn) {  // copied twice per run: at the first step and the second
+      loads_.velocity_turn = turn;
+      turn_handed_ = &turn;
     }
     return &loads_;
   }

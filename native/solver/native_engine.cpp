@@ -119,9 +119,9 @@ void NativeEngine::step(const Loads* loads) {
       bodies_.velocity[p.body] = p.velocity;
       bodies_.angular_velocity[p.body] = p.angular_velocity;
     }
-    if (!loads->any) loads = nullptr;  // no forces to add: skip the pass
+    if (!loads->any && loads->velocity_turn.empty()) loads = nullptr;  // nothing to add: skip the pass
   }
-  find_pairs(loads);                           // 1. pairs
+  find_pairs(loads && loads->any ? loads : nullptr);  // 1. pairs (a velocity turn keeps the speed)
   build_manifolds();                           // 2. manifolds, classified on the velocities before the step
   if (loads) apply_loads(*loads);              // 3. non-contact forces
   if (!manifolds_.empty()) solve_contacts();  // 4. contact impulses
@@ -247,6 +247,9 @@ double NativeEngine::contact_kinetic_energy() const {
 
 void NativeEngine::apply_loads(const Loads& loads) {
   const std::size_t nb = bodies_.position.size();
+  if (!loads.velocity_turn.empty())
+    for (std::size_t i = 0; i < nb; ++i) bodies_.velocity[i] = loads.velocity_turn[i].apply(bodies_.velocity[i]);
+  if (!loads.any) return;
   for (std::size_t i = 0; i < nb; ++i) {
     bodies_.velocity[i] += (dt_ * bodies_.inv_mass[i]) * loads.force[i];
     bodies_.angular_velocity[i] += dt_ * bodies_.inv_inertia[i] * loads.torque[i];

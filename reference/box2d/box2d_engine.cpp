@@ -184,6 +184,13 @@ void Box2dEngine::step(const Loads* loads) {
       bodies_[p.body]->SetLinearVelocity(b2Vec2(static_cast<float>(p.velocity.x), static_cast<float>(p.velocity.y)));
       bodies_[p.body]->SetAngularVelocity(static_cast<float>(p.angular_velocity));
     }
+    if (!loads->velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
+      for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        if (bodies_[i]->GetType() != b2_dynamicBody) continue;
+        const b2Vec2 v = bodies_[i]->GetLinearVelocity();
+        const Vec2 turned = loads->velocity_turn[i].apply({v.x, v.y});
+        bodies_[i]->SetLinearVelocity(b2Vec2(static_cast<float>(turned.x), static_cast<float>(turned.y)));
+      }
     if (loads->any)
       for (std::size_t i = 0; i < bodies_.size(); ++i) {
         if (bodies_[i]->GetType() != b2_dynamicBody) continue;

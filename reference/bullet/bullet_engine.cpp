@@ -220,6 +220,13 @@ void BulletEngine::step(const Loads* loads) {
       t.setOrigin(t.getOrigin() + btVector3(p.velocity.x, p.velocity.y, 0) * dt_);
       b->getMotionState()->setWorldTransform(t);
     }
+    if (!loads->velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
+      for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        if (bodies_[i]->getInvMass() == 0) continue;
+        const btVector3& v = bodies_[i]->getLinearVelocity();
+        const Vec2 turned = loads->velocity_turn[i].apply({v.x(), v.y()});
+        bodies_[i]->setLinearVelocity(btVector3(turned.x, turned.y, 0));
+      }
     if (loads->any)
       for (std::size_t i = 0; i < bodies_.size(); ++i) {
         if (bodies_[i]->getInvMass() == 0) continue;

@@ -254,6 +254,13 @@ void OdeEngine::step(const Loads* loads) {
       dBodySetLinearVel(bodies_[p.body], p.velocity.x, p.velocity.y, 0.0);
       dBodySetAngularVel(bodies_[p.body], 0.0, 0.0, p.angular_velocity);
     }
+    if (!loads->velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
+      for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        if (!bodies_[i] || dBodyIsKinematic(bodies_[i])) continue;
+        const dReal* v = dBodyGetLinearVel(bodies_[i]);
+        const Vec2 turned = loads->velocity_turn[i].apply({v[0], v[1]});
+        dBodySetLinearVel(bodies_[i], turned.x, turned.y, 0.0);
+      }
     if (loads->any)
       for (std::size_t i = 0; i < bodies_.size(); ++i) {
         if (!bodies_[i] || dBodyIsKinematic(bodies_[i])) continue;
