@@ -1,9 +1,21 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing, builds, and runs every test with ctest.
+#   scripts/test.sh              Release build in ./build
+#   scripts/test.sh --sanitize   the same suite built with AddressSanitizer and
+#                                UndefinedBehaviorSanitizer in ./build-sanitize; any report fails
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$root/scripts/setup.sh"
-bash "$root/scripts/build.sh"
-build="${FLOEDEM_BUILD_DIR:-$root/build}"
+jobs="$(nproc 2>/dev/null || echo 2)"
+if [[ "${1:-}" == "--sanitize" ]]; then
+  build="${FLOEDEM_BUILD_DIR:-$root/build-sanitize}"
+  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLOEDEM_SANITIZE=ON >/dev/null
+  cmake --build "$build" -j "$jobs"
+  export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:${ASAN_OPTIONS:-}"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
+else
+  bash "$root/scripts/build.sh"
+  build="${FLOEDEM_BUILD_DIR:-$root/build}"
+fi
 cd "$build"
-ctest --output-on-failure -j "$(nproc 2>/dev/null || echo 2)"
+ctest --output-on-failure -j "$jobs"

@@ -103,7 +103,7 @@ TEST_CASE("collision forces: floe into a fixed structure, off-centre, rotation i
   check_pulse(r, 1.5e-4);
 }
 
-TEST_CASE("collision forces: one event per impact; resting contact after it adds nothing", "[contacts]") {
+TEST_CASE("collision forces: one event per impact, and resting contact after it adds nothing", "[contacts]") {
   // A floe driven into a wall by a constant force: it hits (a collision), then stays pressed
   // (resting contacts every step until the end): one event, J the impact's impulse alone.
   const BodyText wall{"wall", test::box({10.0, 0.0}, 10.0, 40.0), {}, 0.0, true};

@@ -139,7 +139,7 @@ TEST_CASE("scenario [field]: bad keys are refused with file, field and range", "
   }
 }
 
-TEST_CASE("cli: floedem field writes a field file; bad input exits 2 naming the flag and writes nothing",
+TEST_CASE("cli: floedem field writes a field file, and bad input exits 2 naming the flag and writes nothing",
           "[field][cli]") {
   const fs::path d = dir_for("cli");
   const std::string common = " --width 200 --height 150 --alpha 2 --dmin 3 --dmax 30 --thickness 1.16 --seed 3";
