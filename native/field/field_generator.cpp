@@ -15,7 +15,6 @@
 #include "field/power_diagram.hpp"
 #include "geometry/convex_partition.hpp"
 #include "geometry/polygon.hpp"
-#include "geometry/sat.hpp"
 #include "parallel/threads.hpp"
 
 namespace floedem {
