@@ -146,6 +146,13 @@ void read_output(TableReader& root, Scene& scene) {
 void check_polygon(TableReader& r, BodySpec& b) {
   if (b.polygon.size() < 3)
     r.fail("polygon", "has " + std::to_string(b.polygon.size()) + " vertices; allowed at least 3");
+  // Coordinates within 1e7 m (ten thousand kilometres, beyond any ice field): far larger ones
+  // are typing errors, and they break the convex partition's arithmetic (found by fuzzing:
+  // a vertex at 4e75 m crashed CGAL's optimal partition).
+  constexpr double kLargest = 1e7;
+  for (std::size_t k = 0; k < b.polygon.size(); ++k)
+    if (!(std::abs(b.polygon[k].x) <= kLargest && std::abs(b.polygon[k].y) <= kLargest))
+      r.fail("polygon", "vertex " + std::to_string(k) + " lies beyond 1e7 m; allowed |x|, |y| <= 1e7 m");
   if (const auto hit = find_self_intersection(b.polygon)) {
     r.fail("polygon", "is self-intersecting (edges " + std::to_string(hit->first) + " and " +
                           std::to_string(hit->second) + " touch or cross, counting from 0); allowed a simple polygon");

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Fuzzing: builds the libFuzzer targets of tests/fuzz with clang (address and undefined-
+# behaviour sanitizers on) in ./build-fuzz and runs each for SECONDS (default 60), starting
+# from the committed corpus in tests/fuzz/corpus. A crash, a hang (10 s per input), a failed
+# check or a sanitizer report fails the script; libFuzzer leaves the input as build-fuzz/crash-*.
+#   scripts/fuzz.sh [SECONDS]
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+seconds="${1:-60}"
+bash "$root/scripts/setup.sh"
+build="${FLOEDEM_FUZZ_BUILD_DIR:-$root/build-fuzz}"
+jobs="$(nproc 2>/dev/null || echo 2)"
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLOEDEM_FUZZ=ON \
+  -DBUILD_TESTING=OFF >/dev/null
+cmake --build "$build" -j "$jobs" --target fuzz_scenario fuzz_contact
+cd "$build"
+for target in scenario contact; do
+  work="$build/corpus-$target"  # new inputs go here; the committed corpus is read only
+  mkdir -p "$work"
+  echo "fuzz: $target for $seconds s"
+  status=0
+  "$build/fuzz_$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    "$work" "$root/tests/fuzz/corpus/$target" > "$build/fuzz_$target.log" 2>&1 || status=$?
+  grep -E "stat::number_of_executed_units|ERROR|SUMMARY|Test unit written" "$build/fuzz_$target.log" || true
+  if [[ $status -ne 0 ]]; then
+    echo "fuzz: $target failed (exit $status); log in $build/fuzz_$target.log:" >&2
+    tail -n 60 "$build/fuzz_$target.log" >&2
+    exit 1
+  fi
+done
