@@ -148,9 +148,12 @@ Domain make_domain(const FieldSpec& spec, bool check) {
     if (check) {
       if (poly.size() < 3)
         throw FieldSpecError("keep_out[" + std::to_string(k) + "]", name + " has " + std::to_string(poly.size()) + " vertices; allowed at least 3");
+      // Finite and within 1e7 m, as for bodies: far larger coordinates break the convex
+      // partition's arithmetic (scenario.cpp, check_polygon).
       for (const Vec2 v : poly)
-        if (!std::isfinite(v.x) || !std::isfinite(v.y))
-          throw FieldSpecError("keep_out[" + std::to_string(k) + "]", name + " has a vertex that is not a finite number");
+        if (!(std::abs(v.x) <= 1e7 && std::abs(v.y) <= 1e7))
+          throw FieldSpecError("keep_out[" + std::to_string(k) + "]",
+                               name + " has a vertex that is not a finite number within 1e7 m; allowed |x|, |y| <= 1e7 m");
       if (find_self_intersection(poly))
         throw FieldSpecError("keep_out[" + std::to_string(k) + "]", name + " is self-intersecting; allowed a simple polygon");
       if (!(std::abs(signed_area(poly)) > 0.0))
@@ -446,10 +449,11 @@ void check_range(const std::string& name, double v, double lo, double hi, bool l
 
 void check_field_spec(const FieldSpec& s) {
   constexpr double inf = std::numeric_limits<double>::infinity();
-  if (!std::isfinite(s.origin.x) || !std::isfinite(s.origin.y))
-    throw FieldSpecError("origin", "origin is not a pair of finite numbers");
-  check_range("width", s.width, 0.0, inf, true, true);
-  check_range("height", s.height, 0.0, inf, true, true);
+  // Coordinates within 1e7 m, as for bodies (scenario.cpp, check_polygon).
+  if (!(std::abs(s.origin.x) <= 1e7 && std::abs(s.origin.y) <= 1e7))
+    throw FieldSpecError("origin", "origin is not a pair of finite numbers within 1e7 m; allowed |x|, |y| <= 1e7 m");
+  check_range("width", s.width, 0.0, 1e7, true, false);
+  check_range("height", s.height, 0.0, 1e7, true, false);
   check_range("concentration", s.concentration, 0.0, FieldSpec::max_concentration, true, false);
   check_range("alpha", s.alpha, 0.0, 10.0, true, false);
   check_range("d_min", s.d_min, 0.0, inf, true, true);

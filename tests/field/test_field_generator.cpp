@@ -174,7 +174,7 @@ TEST_CASE("field: bad parameters name the parameter and the allowed range", "[fi
       {"d_max", [](FieldSpec& s) { s.d_max = s.d_min; }, "allowed ("},
       {"d_min", [](FieldSpec& s) { s.d_min = 0.0; }, "(0, inf)"},
       {"width", [](FieldSpec& s) { s.width = 0.5 * s.d_max; }, "at least d_max"},
-      {"height", [](FieldSpec& s) { s.height = -1.0; }, "(0, inf)"},
+      {"height", [](FieldSpec& s) { s.height = -1.0; }, "(0, 1e+07]"},
       {"irregularity", [](FieldSpec& s) { s.irregularity = 1.5; }, "[0, 1]"},
       {"thickness", [](FieldSpec& s) { s.thickness.value = 0.0; }, "(0, inf)"},
       {"keep_out", [](FieldSpec& s) {
@@ -188,6 +188,8 @@ TEST_CASE("field: bad parameters name the parameter and the allowed range", "[fi
       {"keep_out[0]", [](FieldSpec& s) {
          s.keep_out = {{s.origin, s.origin + Vec2{50, 50}, s.origin + Vec2{50, 0}, s.origin + Vec2{0, 50}}};
        }, "self-intersecting"},
+      {"keep_out[0]", [](FieldSpec& s) { s.keep_out = {{s.origin, s.origin + Vec2{4e75, 0}, s.origin + Vec2{0, 50}}}; },
+       "within 1e7 m"},
   };
   for (const Bad& b : cases) {
     FieldSpec s = spec_for(0.5, 2.0, 500);
