@@ -25,6 +25,25 @@ CompliantContact compliant_contact(const ContactSettings& contact) {
   return c;
 }
 
+CompliantContacts::CompliantContacts(const Scene& scene) : law_(compliant_contact(scene.contact)) {
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    inv_mass_.push_back(scene.engine_inverse_mass(i));
+    inv_inertia_.push_back(scene.engine_inverse_inertia(i));
+  }
+}
+
+CompliantContacts::PerPoint CompliantContacts::per_point(std::size_t a, std::size_t b, Vec2 normal, Vec2 r_a, Vec2 r_b,
+                                                         int points) const {
+  const double m_eff = effective_mass(normal, r_a, inv_mass_[a], inv_inertia_[a], r_b, inv_mass_[b], inv_inertia_[b]);
+  const double share = 1.0 / points;
+  return {share * law_.stiffness, share * 2.0 * law_.damping_ratio * std::sqrt(law_.stiffness * m_eff)};
+}
+
+void CompliantContacts::describe(std::map<std::string, std::string>& settings) const {
+  settings["contact_stiffness"] = setting_text(law_.stiffness);
+  settings["contact_damping_ratio"] = setting_text(law_.damping_ratio);
+}
+
 DurationModel duration_model_of(const EngineInfo& engine) {
   const auto it = engine.settings.find("contact_model");
   return it != engine.settings.end() && it->second == "compliant" ? DurationModel::measured : DurationModel::estimated;
@@ -38,20 +57,11 @@ const char* describe(DurationModel model) {
 }
 
 CollisionTracker::CollisionTracker(const Scene& scene, DurationModel model)
-    : c_tau_(scene.contact.duration_coefficient),
+    : scene_(scene),
+      c_tau_(scene.contact.duration_coefficient),
       dt_(scene.run.dt),
       threshold_(scene.contact.collision_threshold),
-      model_(model) {
-  const std::size_t n = scene.bodies.size();
-  inv_mass_.resize(n);
-  inv_inertia_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    // The masses the engines see (added mass included when the scene says so).
-    const bool moves = !scene.bodies[i].fixed && !scene.bodies[i].prescribed;
-    inv_mass_[i] = moves ? 1.0 / scene.engine_mass(i) : 0.0;
-    inv_inertia_[i] = moves ? 1.0 / scene.engine_inertia(i) : 0.0;
-  }
-}
+      model_(model) {}
 
 CollisionRow CollisionTracker::open_row(double t_end, const StepPair& p, const BodyStates& after) const {
   CollisionRow row;
@@ -68,7 +78,8 @@ CollisionRow CollisionTracker::open_row(double t_end, const StepPair& p, const B
   const Vec2 xa = after.position[a] - dt_ * after.velocity[a];
   const Vec2 xb = after.position[b] - dt_ * after.velocity[b];
   const Vec2 ra = point - xa, rb = point - xb;
-  row.effective_mass = effective_mass(normal, ra, inv_mass_[a], inv_inertia_[a], rb, inv_mass_[b], inv_inertia_[b]);
+  row.effective_mass = effective_mass(normal, ra, scene_.engine_inverse_mass(a), scene_.engine_inverse_inertia(a), rb,
+                                      scene_.engine_inverse_mass(b), scene_.engine_inverse_inertia(b));
   row.approach_speed = approach;
   // Separation speed after the step at the same material points (the turn of the lever arms
   // within the step is second order in dt w: neglected).

@@ -17,6 +17,7 @@
 // engine reports.
 #include <cstdint>
 #include <map>
+#include <string>
 #include <span>
 #include <utility>
 #include <vector>
@@ -67,6 +68,27 @@ struct CompliantContact {
 };
 CompliantContact compliant_contact(const ContactSettings& contact);
 
+/// The compliant contact as the reference engines apply it: a pair's spring and dashpot
+/// shared by its `points` touching points, the dashpot from the pair's m_eff along the normal
+/// at the points' middle (at a single corner point m_eff would count the turn that the other
+/// points' springs prevent: 0.4 m instead of m for a face contact).
+class CompliantContacts {
+ public:
+  explicit CompliantContacts(const Scene& scene);
+  struct PerPoint {
+    double stiffness = 0.0;  ///< N/m
+    double damping = 0.0;    ///< N s/m
+  };
+  /// r_a, r_b: lever arms of the points' middle from the centroids of bodies a and b.
+  PerPoint per_point(std::size_t a, std::size_t b, Vec2 normal, Vec2 r_a, Vec2 r_b, int points) const;
+  /// contact_stiffness and contact_damping_ratio, for EngineInfo::settings.
+  void describe(std::map<std::string, std::string>& settings) const;
+
+ private:
+  CompliantContact law_;
+  std::vector<double> inv_mass_, inv_inertia_;
+};
+
 class CollisionTracker {
  public:
   explicit CollisionTracker(const Scene& scene, DurationModel model = DurationModel::estimated);
@@ -98,7 +120,7 @@ class CollisionTracker {
   CollisionRow complete(const Event& event, const BodyStates& now) const;  ///< duration, forces, restitution
   Event open_event(double t_end, const StepPair& pair, const BodyStates& after) const;
 
-  std::vector<double> inv_mass_, inv_inertia_;
+  const Scene& scene_;
   double c_tau_ = 0.0, dt_ = 0.0, threshold_ = 0.0;
   DurationModel model_ = DurationModel::estimated;
   std::int64_t step_ = 0;

@@ -70,6 +70,14 @@ double Scene::engine_inertia(std::size_t i) const {
   return b.inertia * (environment.added_mass_in_contacts ? 1.0 + b.added_mass_coefficient : 1.0);
 }
 
+double Scene::engine_inverse_mass(std::size_t i) const {
+  return bodies[i].fixed || bodies[i].prescribed ? 0.0 : 1.0 / engine_mass(i);
+}
+
+double Scene::engine_inverse_inertia(std::size_t i) const {
+  return bodies[i].fixed || bodies[i].prescribed ? 0.0 : 1.0 / engine_inertia(i);
+}
+
 Vec2 EnvironmentSpec::current_at(double depth) const {
   if (current_profile.empty()) return current;
   Vec2 v = current_profile.front().velocity;

@@ -165,6 +165,10 @@ struct Scene {
   /// Mass the engines move: m, plus the added mass when it enters contacts too.
   double engine_mass(std::size_t body) const;
   double engine_inertia(std::size_t body) const;
+  /// 1 / engine_mass and 1 / engine_inertia, 0 for a fixed or prescribed body (infinite mass
+  /// in contacts).
+  double engine_inverse_mass(std::size_t body) const;
+  double engine_inverse_inertia(std::size_t body) const;
 };
 
 }  // namespace floedem

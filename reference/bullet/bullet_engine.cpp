@@ -103,12 +103,11 @@ class BulletEngine final : public Engine {
   BodyStates state_, before_;
   std::vector<ContactRecord> records_;
   double max_out_of_plane_ = 0.0;  // m and rad, over the run
-  std::vector<double> inv_mass_, inv_inertia_;
-  double stiffness_ = 0.0, damping_ratio_ = 0.0;  // compliant contact of a pair
+  CompliantContacts compliance_;  // used when settings_.compliant
 };
 
 BulletEngine::BulletEngine(const Scene& scene)
-    : settings_(read_settings(scene)), dt_(scene.run.dt), threshold_(scene.contact.collision_threshold) {
+    : settings_(read_settings(scene)), dt_(scene.run.dt), threshold_(scene.contact.collision_threshold), compliance_(scene) {
   gCalculateCombinedRestitutionCallback = combined_restitution;
   gCalculateCombinedFrictionCallback = combined_friction;
   world_.setGravity(btVector3(0, 0, 0));
@@ -116,13 +115,7 @@ BulletEngine::BulletEngine(const Scene& scene)
   info.m_numIterations = settings_.iterations;
   info.m_splitImpulse = settings_.compliant ? 0 : 1;
   info.m_splitImpulsePenetrationThreshold = 0;
-  if (settings_.compliant) {
-    // The same spring as ODE's compliant model and native's estimate (contacts/collision_forces.hpp).
-    const CompliantContact compliant = compliant_contact(scene.contact);
-    stiffness_ = compliant.stiffness;
-    damping_ratio_ = compliant.damping_ratio;
-    world_.before_solve = [this] { set_compliance(); };
-  }
+  if (settings_.compliant) world_.before_solve = [this] { set_compliance(); };
   info.m_restitutionVelocityThreshold = threshold_;
 
   // Taller than any overlap can get: four times the largest body.
@@ -163,8 +156,6 @@ BulletEngine::BulletEngine(const Scene& scene)
     btRigidBody::btRigidBodyConstructionInfo ci(mass, motion_states_.back().get(), shape,
                                                 dynamic ? btVector3(izz, izz, izz) : btVector3(0, 0, 0));
     ci.m_restitution = settings_.compliant ? 0.0 : scene.contact.restitution;
-    inv_mass_.push_back(dynamic ? 1.0 / scene.engine_mass(i) : 0.0);
-    inv_inertia_.push_back(dynamic ? 1.0 / izz : 0.0);
     ci.m_friction = scene.contact.friction;
     ci.m_linearDamping = 0;
     ci.m_angularDamping = 0;
@@ -201,10 +192,7 @@ EngineInfo BulletEngine::info() const {
                 {"restitution_velocity_threshold", setting_text(threshold_)},
                 {"combine", "restitution max, friction min"},
                 {"max_out_of_plane", setting_text(max_out_of_plane_)}};
-  if (settings_.compliant) {
-    i.settings["contact_stiffness"] = setting_text(stiffness_);
-    i.settings["contact_damping_ratio"] = setting_text(damping_ratio_);
-  }
+  if (settings_.compliant) compliance_.describe(i.settings);
   i.limitations = {"bodies are prisms held in the plane by linear and angular factors",
                    "up to 4 contact points per pair, top and bottom of the prism (compare impulses summed per pair)"};
   return i;
@@ -240,8 +228,8 @@ void BulletEngine::step(const Loads* loads) {
 }
 
 void BulletEngine::set_compliance() {
-  // Per pair: spring k and dashpot c = 2 zeta sqrt(k m_eff) shared by its touching points (up
-  // to four: the prism's top and bottom), m_eff along the normal at the points' middle.
+  // Per pair: spring and dashpot shared by its touching points (up to four: the prism's top
+  // and bottom), from the points' middle (contacts/collision_forces.hpp).
   const int manifolds = dispatcher_.getNumManifolds();
   for (int k = 0; k < manifolds; ++k) {
     btPersistentManifold* pm = dispatcher_.getManifoldByIndexInternal(k);
@@ -262,14 +250,13 @@ void BulletEngine::set_compliance() {
       return Vec2{c.x(), c.y()};
     };
     const btVector3& nb = pm->getContactPoint(0).m_normalWorldOnB;
-    const double m_eff = effective_mass({nb.x(), nb.y()}, middle - centre(i0), inv_mass_[static_cast<std::size_t>(i0)],
-                                        inv_inertia_[static_cast<std::size_t>(i0)], middle - centre(i1),
-                                        inv_mass_[static_cast<std::size_t>(i1)], inv_inertia_[static_cast<std::size_t>(i1)]);
-    const double share = 1.0 / touching;
+    const auto [stiffness, damping] = compliance_.per_point(static_cast<std::size_t>(i0), static_cast<std::size_t>(i1),
+                                                            {nb.x(), nb.y()}, middle - centre(i0), middle - centre(i1),
+                                                            touching);
     for (int j = 0; j < pm->getNumContacts(); ++j) {
       btManifoldPoint& pt = pm->getContactPoint(j);
-      pt.m_combinedContactStiffness1 = share * stiffness_;
-      pt.m_combinedContactDamping1 = share * 2.0 * damping_ratio_ * std::sqrt(stiffness_ * m_eff);
+      pt.m_combinedContactStiffness1 = stiffness;
+      pt.m_combinedContactDamping1 = damping;
       pt.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
     }
   }

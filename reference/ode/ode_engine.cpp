@@ -93,13 +93,11 @@ class OdeEngine final : public Engine {
   std::vector<ContactRecord> records_;
   BodyStates state_;
   double max_out_of_plane_ = 0.0;
-  std::vector<double> inv_mass_, inv_inertia_;
-  double stiffness_ = 0.0;     ///< N/m, compliant contact spring of a pair
-  double damping_ratio_ = 0.0; ///< zeta of the compliant contact
+  CompliantContacts compliance_;  ///< used when settings_.compliant
 };
 
 OdeEngine::OdeEngine(const Scene& scene)
-    : settings_(read_settings(scene)), dt_(scene.run.dt), contact_(scene.contact), parts_(scene) {
+    : settings_(read_settings(scene)), dt_(scene.run.dt), contact_(scene.contact), parts_(scene), compliance_(scene) {
   static std::once_flag init;
   std::call_once(init, [] { dInitODE2(0); });
   world_ = dWorldCreate();
@@ -109,19 +107,12 @@ OdeEngine::OdeEngine(const Scene& scene)
   // A compliant contact is all correction: its spring must not be capped.
   dWorldSetContactMaxCorrectingVel(world_, settings_.compliant ? dInfinity : settings_.max_correcting_velocity);
   dWorldSetQuickStepNumIterations(world_, settings_.iterations);
-  // Compliant contact (MODEL.md 4): the same spring as native's estimate (contacts/collision_forces.hpp).
-  const CompliantContact compliant = compliant_contact(contact_);
-  stiffness_ = compliant.stiffness;
-  damping_ratio_ = compliant.damping_ratio;
   dWorldSetAutoDisableFlag(world_, 0);
   contact_group_ = dJointGroupCreate(0);
   const std::size_t n = scene.bodies.size();
   for (std::size_t i = 0; i < n; ++i) {
     const BodySpec& b = scene.bodies[i];
     fixed_position_.push_back(b.centroid);
-    const bool moves = !b.fixed && !b.prescribed;
-    inv_mass_.push_back(moves ? 1.0 / scene.engine_mass(i) : 0.0);
-    inv_inertia_.push_back(moves ? 1.0 / scene.engine_inertia(i) : 0.0);
     if (b.fixed) {
       bodies_.push_back(nullptr);
       continue;
@@ -166,10 +157,7 @@ EngineInfo OdeEngine::info() const {
                 {"friction", "dContactApprox1, in-plane tangent only"},
                 {"contact_geometry", "floedem 2-D narrow phase"},
                 {"max_out_of_plane", setting_text(max_out_of_plane_)}};
-  if (settings_.compliant) {
-    i.settings["contact_stiffness"] = setting_text(stiffness_);
-    i.settings["contact_damping_ratio"] = setting_text(damping_ratio_);
-  }
+  if (settings_.compliant) compliance_.describe(i.settings);
   i.limitations = {"contact points from floedem's 2-D narrow phase, not ODE's colliders (one point per step for convex prisms)",
                    "contacts found only once bodies touch (no speculative contact): impacts resolve after up to v dt of overlap"};
   return i;
@@ -200,20 +188,17 @@ void OdeEngine::step(const Loads* loads) {
       c.surface.bounce_vel = contact_.collision_threshold;
       c.surface.soft_cfm = settings_.cfm;
       if (settings_.compliant) {
-        // Spring k and dashpot c shared by the manifold's points; ODE's implicit spring-damper:
-        // ERP = h k / (h k + c), CFM = 1 / (h k + c) (ODE manual, "Soft constraint and
-        // constraint force mixing"). c = 2 zeta sqrt(k m_eff), m_eff of the pair along the
-        // normal at the middle of the manifold (at a corner point it would count the turn that
-        // the other point's spring prevents: for a face contact 0.4 m instead of m).
-        const double share = 1.0 / m.point_count;
+        // The pair's spring k and dashpot c shared by the manifold's points (contacts/
+        // collision_forces.hpp), as ODE's implicit spring-damper: ERP = h k / (h k + c),
+        // CFM = 1 / (h k + c) (ODE manual, "Soft constraint and constraint force mixing").
         Vec2 middle;
-        for (int q = 0; q < m.point_count; ++q) middle += share * m.points[q].point;
-        const double m_eff = effective_mass(m.normal, middle - state_.position[a], inv_mass_[a], inv_inertia_[a],
-                                            middle - state_.position[b], inv_mass_[b], inv_inertia_[b]);
-        const double k = share * stiffness_, damping = share * 2.0 * damping_ratio_ * std::sqrt(stiffness_ * m_eff);
+        for (int q = 0; q < m.point_count; ++q) middle += (1.0 / m.point_count) * m.points[q].point;
+        const auto [stiffness, damping] = compliance_.per_point(static_cast<std::size_t>(a), static_cast<std::size_t>(b), m.normal,
+                                                                middle - state_.position[a], middle - state_.position[b],
+                                                                m.point_count);
         c.surface.mode = dContactSoftERP | dContactSoftCFM | dContactApprox1 | dContactFDir1 | dContactMu2;
-        c.surface.soft_erp = dt_ * k / (dt_ * k + damping);
-        c.surface.soft_cfm = 1.0 / (dt_ * k + damping);
+        c.surface.soft_erp = dt_ * stiffness / (dt_ * stiffness + damping);
+        c.surface.soft_cfm = 1.0 / (dt_ * stiffness + damping);
       }
       // ODE: moving body 1 along the normal by depth separates the bodies.
       const Vec2 normal = b_is_body1 ? m.normal : -m.normal;
