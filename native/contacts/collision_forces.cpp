@@ -63,8 +63,10 @@ CollisionTracker::CollisionTracker(const Scene& scene, DurationModel model)
       threshold_(scene.contact.collision_threshold),
       model_(model) {}
 
-CollisionRow CollisionTracker::open_row(double t_end, const StepPair& p, const BodyStates& after) const {
-  CollisionRow row;
+CollisionTracker::Event CollisionTracker::open_event(double t_end, const StepPair& p, const BodyStates& after) const {
+  Event e;
+  e.first_step = e.last_step = step_;
+  CollisionRow& row = e.row;
   row.time = t_end;
   row.body_a = p.a;
   row.body_b = p.b;
@@ -82,21 +84,13 @@ CollisionRow CollisionTracker::open_row(double t_end, const StepPair& p, const B
                                       scene_.engine_inverse_mass(b), scene_.engine_inverse_inertia(b));
   row.approach_speed = approach;
   // Separation speed after the step at the same material points (the turn of the lever arms
-  // within the step is second order in dt w: neglected).
+  // within the step is second order in dt w: neglected). The measured model replaces it once
+  // the pair has separated, from the point kept in each body's frame.
   const Vec2 va = after.velocity[a] + cross(after.angular_velocity[a], ra);
   const Vec2 vb = after.velocity[b] + cross(after.angular_velocity[b], rb);
   row.restitution_achieved = approach > 0.0 ? dot(vb - va, normal) / approach : 0.0;
-  return row;
-}
-
-CollisionTracker::Event CollisionTracker::open_event(double t_end, const StepPair& p, const BodyStates& after) const {
-  Event e;
-  e.row = open_row(t_end, p, after);
-  e.first_step = e.last_step = step_;
   if (model_ == DurationModel::measured) {
-    const auto a = static_cast<std::size_t>(p.a), b = static_cast<std::size_t>(p.b);
-    const Vec2 point = (1.0 / p.collision_impulse) * p.weighted_point;
-    e.normal = normalized(p.weighted_normal);
+    e.normal = normal;
     e.local_a = Rot::from_angle(after.angle[a]).apply_inverse(point - after.position[a]);
     e.local_b = Rot::from_angle(after.angle[b]).apply_inverse(point - after.position[b]);
   }

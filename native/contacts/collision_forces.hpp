@@ -116,7 +116,6 @@ class CollisionTracker {
     double impulse = 0.0;            ///< N s, all this step's normal impulses (measured model)
   };
   using PairKey = std::pair<std::int32_t, std::int32_t>;
-  CollisionRow open_row(double t_end, const StepPair& pair, const BodyStates& after) const;
   CollisionRow complete(const Event& event, const BodyStates& now) const;  ///< duration, forces, restitution
   Event open_event(double t_end, const StepPair& pair, const BodyStates& after) const;
 

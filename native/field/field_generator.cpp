@@ -78,18 +78,25 @@ void clip(const LabeledPolygon& in, LabeledPolygon& out, Vec2 n, double c, std::
   }
 }
 
-/// Area and first moment of a convex polygon cut by another convex polygon.
-AreaMoments intersection_moments(const std::vector<Vec2>& cell, const std::vector<Vec2>& piece) {
-  LabeledPolygon a{cell, std::vector<std::int32_t>(cell.size(), -1)}, b;
-  const std::size_t m = piece.size();
+/// A convex polygon cut by another convex counter-clockwise polygon (empty when they are
+/// disjoint).
+std::vector<Vec2> clip_to_convex(const std::vector<Vec2>& poly, const std::vector<Vec2>& convex) {
+  LabeledPolygon a{poly, std::vector<std::int32_t>(poly.size(), -1)}, b;
+  const std::size_t m = convex.size();
   for (std::size_t k = 0; k < m && !a.p.empty(); ++k) {
-    const Vec2 e = piece[(k + 1) % m] - piece[k];
+    const Vec2 e = convex[(k + 1) % m] - convex[k];
     const Vec2 n{e.y, -e.x};  // outward normal of a counter-clockwise edge
-    clip(a, b, n, dot(n, piece[k]), -1);
+    clip(a, b, n, dot(n, convex[k]), -1);
     std::swap(a, b);
   }
-  if (a.p.size() < 3) return {};
-  return area_moments(a.p);
+  return std::move(a.p);
+}
+
+/// Area and first moment of a convex polygon cut by another convex polygon.
+AreaMoments intersection_moments(const std::vector<Vec2>& cell, const std::vector<Vec2>& piece) {
+  const std::vector<Vec2> cut = clip_to_convex(cell, piece);
+  if (cut.size() < 3) return {};
+  return area_moments(cut);
 }
 
 /// Length of the segment pq inside a convex counter-clockwise polygon (Cyrus-Beck clipping).
@@ -161,28 +168,21 @@ Domain make_domain(const FieldSpec& spec, bool check) {
     }
     if (signed_area(poly) < 0.0) std::reverse(poly.begin(), poly.end());
     for (std::vector<Vec2>& part : convex_partition(poly)) {
-      const AreaMoments in = intersection_moments(part, rect);
-      if (in.area <= 0.0) continue;
       // The part clipped to the domain (so that its area counts once).
-      LabeledPolygon a{part, std::vector<std::int32_t>(part.size(), -1)}, b;
-      for (std::size_t e = 0; e < 4; ++e) {
-        const Vec2 edge = rect[(e + 1) % 4] - rect[e];
-        const Vec2 n{edge.y, -edge.x};
-        clip(a, b, n, dot(n, rect[e]), -1);
-        std::swap(a, b);
-      }
-      std::vector<Vec2> clipped = remove_collinear(a.p, 1e-12);
+      std::vector<Vec2> clipped = remove_collinear(clip_to_convex(part, rect), 1e-12);
       if (clipped.size() < 3) continue;
+      const double area = area_moments(clipped).area;
+      if (area <= 0.0) continue;
       if (check) {
         for (std::size_t j = 0; j < d.keep_out.size(); ++j) {
           if (owner[j] == k || !d.keep_out[j].box.overlaps(bounds_of(clipped))) continue;
-          if (intersection_moments(clipped, d.keep_out[j].polygon).area > 1e-9 * in.area)
+          if (intersection_moments(clipped, d.keep_out[j].polygon).area > 1e-9 * area)
             throw FieldSpecError("keep_out[" + std::to_string(k) + "]",
                                  name + " overlaps " + name_of(owner[j]) +
                                      "; allowed keep-out zones that do not overlap each other");
         }
       }
-      covered += area_moments(clipped).area;
+      covered += area;
       d.keep_out.push_back({clipped, bounds_of(clipped)});
       owner.push_back(k);
     }
