@@ -123,8 +123,8 @@ struct Recorder::Impl {
   ContactOutput contact_output = ContactOutput::all;
   // Towing.
   bool tow = false;
-  Series tow_force, tow_force_mean, tow_tug;
-  std::vector<double> w_force, w_mean, w_tug;
+  Series tow_time, tow_force, tow_force_mean, tow_ice_mean, tow_tug;
+  std::vector<double> w_time, w_force, w_mean, w_ice, w_tug;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false;
 
@@ -136,13 +136,16 @@ struct Recorder::Impl {
       velocity.append(b_velocity.data(), buffered_frames);
       angular_velocity.append(b_angular_velocity.data(), buffered_frames);
       b_time.clear(); b_position.clear(); b_angle.clear(); b_velocity.clear(); b_angular_velocity.clear();
-      if (tow) {
-        tow_force.append(w_force.data(), buffered_frames);
-        tow_force_mean.append(w_mean.data(), buffered_frames);
-        tow_tug.append(w_tug.data(), buffered_frames);
-        w_force.clear(); w_mean.clear(); w_tug.clear();
-      }
       buffered_frames = 0;
+    }
+    if (!w_time.empty()) {
+      const hsize_t n = w_time.size();
+      tow_time.append(w_time.data(), n);
+      tow_force.append(w_force.data(), n);
+      tow_force_mean.append(w_mean.data(), n);
+      tow_ice_mean.append(w_ice.data(), n);
+      tow_tug.append(w_tug.data(), n);
+      w_time.clear(); w_force.clear(); w_mean.clear(); w_ice.clear(); w_tug.clear();
     }
     const hsize_t rows = k_time.size();
     if (rows > 0) {
@@ -300,9 +303,12 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
       H5::Group tow = d.file.createGroup("/tow");
       write_attribute(tow, "mode", scene.tow.mode == TowSpec::Mode::velocity ? "velocity" : "rope");
       write_attribute(tow, "body", scene.bodies[scene.tow.body].name);
-      d.tow_force = Series(tow, "force", H5::PredType::NATIVE_DOUBLE, {2}, d.frame_chunk);
-      d.tow_force_mean = Series(tow, "force_mean", H5::PredType::NATIVE_DOUBLE, {2}, d.frame_chunk);
-      d.tow_tug = Series(tow, "tug_position", H5::PredType::NATIVE_DOUBLE, {2}, d.frame_chunk);
+      constexpr hsize_t kt = 1024;  // rows per chunk: /tow may be written every step
+      d.tow_time = Series(tow, "time", H5::PredType::NATIVE_DOUBLE, {}, kt);
+      d.tow_force = Series(tow, "force", H5::PredType::NATIVE_DOUBLE, {2}, kt);
+      d.tow_force_mean = Series(tow, "force_mean", H5::PredType::NATIVE_DOUBLE, {2}, kt);
+      d.tow_ice_mean = Series(tow, "ice_force_mean", H5::PredType::NATIVE_DOUBLE, {2}, kt);
+      d.tow_tug = Series(tow, "tug_position", H5::PredType::NATIVE_DOUBLE, {2}, kt);
     }
     d.flush();
   } catch (const H5::Exception& e) {
@@ -384,12 +390,14 @@ std::int64_t Recorder::collision_rows() const {
   return static_cast<std::int64_t>(impl_->e_time.rows() + impl_->events.size());
 }
 
-void Recorder::write_tow(Vec2 force, Vec2 mean_force, Vec2 tug_position) {
+void Recorder::write_tow(double time, const TowFrame& f) {
   Impl& d = *impl_;
-  // Called before write_frame for the same frame: the rows line up with /time.
-  d.w_force.insert(d.w_force.end(), {force.x, force.y});
-  d.w_mean.insert(d.w_mean.end(), {mean_force.x, mean_force.y});
-  d.w_tug.insert(d.w_tug.end(), {tug_position.x, tug_position.y});
+  d.w_time.push_back(time);
+  d.w_force.insert(d.w_force.end(), {f.force.x, f.force.y});
+  d.w_mean.insert(d.w_mean.end(), {f.force_mean.x, f.force_mean.y});
+  d.w_ice.insert(d.w_ice.end(), {f.ice_force_mean.x, f.ice_force_mean.y});
+  d.w_tug.insert(d.w_tug.end(), {f.tug_position.x, f.tug_position.y});
+  if (d.w_time.size() >= 4096) d.write_buffers();
 }
 
 std::int64_t Recorder::frames() const {

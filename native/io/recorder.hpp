@@ -12,6 +12,7 @@
 #include "contacts/collision_forces.hpp"
 #include "engine/engine.hpp"
 #include "scene/scene.hpp"
+#include "towing/tow.hpp"
 
 namespace floedem {
 
@@ -39,7 +40,7 @@ class Recorder {
   /// Collision events that ended (/contacts/collisions).
   void write_collisions(std::span<const CollisionRow> rows);
   /// /tow at a frame: force of the last step, mean force since the last frame, tug position.
-  void write_tow(Vec2 force, Vec2 mean_force, Vec2 tug_position);
+  void write_tow(double time, const TowFrame& frame);
   /// Rewrites /engine's attributes (engines report measured figures, e.g. out-of-plane drift).
   void update_engine_info(const EngineInfo& engine);
   /// Attributes on a group (created when missing), e.g. the parameters of a generated field.

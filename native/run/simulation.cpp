@@ -78,8 +78,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const std::int64_t steps = scene.run.steps();
   summary.kinetic_energy_start = kinetic_energy(scene, stepper.state());
   TowMonitor& tow = stepper.tow();
+  const std::int64_t tow_every = scene.output.tow_every > 0 ? scene.output.tow_every : scene.run.output_every;
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-  if (tow.active()) recorder.write_tow({nan, nan}, {nan, nan}, tow.tug_position(0.0));  // no step yet
+  if (tow.active()) recorder.write_tow(0.0, {{nan, nan}, {nan, nan}, {nan, nan}, tow.tug_position(0.0)});  // no step yet
   recorder.write_frame(0.0, stepper.state());
   CollisionTracker collisions(scene, duration_model_of(stepper.engine().info()));
   std::vector<CollisionRow> ended;
@@ -103,10 +104,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     recorder.write_contacts(t_end, contacts);
     collisions.observe(t_end, contacts, state, ended);
     if (!ended.empty()) record_collisions();
-    if (k % scene.run.output_every == 0 || k == steps) {
-      if (tow.active()) recorder.write_tow(tow.force(), tow.take_mean(), tow.tug_position(t_end));
-      recorder.write_frame(t_end, state);
-    }
+    if (tow.active() && (k % tow_every == 0 || k == steps)) recorder.write_tow(t_end, tow.take_frame(t_end));
+    if (k % scene.run.output_every == 0 || k == steps) recorder.write_frame(t_end, state);
     progress.update(k, steps);
   }
   progress.done();

@@ -140,6 +140,7 @@ void read_output(TableReader& root, Scene& scene) {
   const std::string c = r.string("contacts", "all", {"all", "collisions", "none"});
   scene.output.contacts = c == "all" ? ContactOutput::all : c == "collisions" ? ContactOutput::collisions
                                                                              : ContactOutput::none;
+  scene.output.tow_every = static_cast<int>(r.integer("tow_every", 0, 1, 1'000'000'000));
   r.reject_unknown();
 }
 

@@ -34,32 +34,40 @@ void TowMonitor::before_step(const BodyStates& state, double time) {
 }
 
 void TowMonitor::after_step(std::span<const ContactRecord> contacts, const std::array<double, 3>& env) {
+  const double dt = scene_.run.dt;
+  const std::int32_t body = static_cast<std::int32_t>(tow_.body);
+  Vec2 contact;  // N s, the step's contact impulses on the towed body (the normal points from a to b)
+  for (const ContactRecord& c : contacts) {
+    if (c.body_a != body && c.body_b != body) continue;
+    const Vec2 p = c.normal_impulse * c.normal + c.tangent_impulse * perp(c.normal);
+    if (c.body_b == body) contact += p;
+    if (c.body_a == body) contact -= p;
+  }
+  ice_ = -(1.0 / dt) * contact;
   if (tow_.mode == TowSpec::Mode::rope) {
     force_ = rope_.tension * rope_.direction;
   } else if (tow_.mode == TowSpec::Mode::velocity) {
-    const double dt = scene_.run.dt;
     const BodySpec& b = scene_.bodies[tow_.body];
-    const std::int32_t body = static_cast<std::int32_t>(tow_.body);
-    Vec2 contact;
-    for (const ContactRecord& c : contacts) {
-      const Vec2 p = c.normal_impulse * c.normal + c.tangent_impulse * perp(c.normal);
-      if (c.body_b == body) contact += p;
-      if (c.body_a == body) contact -= p;
-    }
     const double mi = b.mass * (1.0 + b.added_mass_coefficient);
     const Vec2 inertial = mi * tow_.acceleration_at(time_ + 0.5 * dt);
     // Rope-free forcing on the body at the start of the step (the rope term is absent here).
-    force_ = inertial - Vec2{env[0], env[1]} - (1.0 / dt) * contact;
+    force_ = inertial - Vec2{env[0], env[1]} + ice_;
   }
   sum_ += force_;
+  ice_sum_ += ice_;
   ++count_;
 }
 
-Vec2 TowMonitor::take_mean() {
-  const Vec2 m = count_ > 0 ? (1.0 / static_cast<double>(count_)) * sum_ : force_;
+TowFrame TowMonitor::take_frame(double time) {
+  TowFrame f;
+  f.force = force_;
+  f.force_mean = count_ > 0 ? (1.0 / static_cast<double>(count_)) * sum_ : force_;
+  f.ice_force_mean = count_ > 0 ? (1.0 / static_cast<double>(count_)) * ice_sum_ : ice_;
+  f.tug_position = tug_position(time);
   sum_ = {};
+  ice_sum_ = {};
   count_ = 0;
-  return m;
+  return f;
 }
 
 }  // namespace floedem

@@ -126,3 +126,49 @@ TEST_CASE("tow output: /tow/force and /tow/tug_position per frame", "[tow][outpu
   CHECK(tug[20] == Approx(7.0).epsilon(1e-12));  // the path's position at t = 10 s
   fs::remove(out);
 }
+
+namespace {
+std::vector<double> read_all(const H5::H5File& f, const std::string& name) {
+  H5::DataSet d = f.openDataSet(name);
+  const hssize_t n = d.getSpace().getSimpleExtentNpoints();
+  std::vector<double> v(static_cast<std::size_t>(n));
+  d.read(v.data(), H5::PredType::NATIVE_DOUBLE);
+  return v;
+}
+}  // namespace
+
+TEST_CASE("tow output: tow_every rows of /tow, and the ice part is the impulse the floes took", "[tow][output]") {
+  // No environment: the towing force is all ice (and inertia, none at constant speed). The berg
+  // at 1 m/s meets a 20 m floe at rest; the towing impulse, the sum of the ice part over the
+  // rows, must equal the momentum the floe carries away (nothing else acts on it).
+  const std::string text =
+      "[run]\nduration = 20.0\ndt = 0.05\noutput_every = 100\n[output]\ntow_every = 3\n[contact]\nrestitution = 0.5\n"
+      "friction = 0.0\n" + kBerg +
+      "[[body]]\nname = \"floe\"\npolygon = [[105,-10],[125,-10],[125,10],[105,10]]\nthickness = 1.0\n"
+      "[tow]\nmode = \"velocity\"\nbody = \"berg\"\nvelocity = [1.0, 0.0]\n";
+  const Scene s = test::scene_from(text);
+  const fs::path out = fs::temp_directory_path() / ("floedem-tow-every-" + std::to_string(::getpid()) + ".h5");
+  RunOptions o;
+  o.output = out.string();
+  run_scene(s, o);
+  H5::H5File f(out.string(), H5F_ACC_RDONLY);
+  const std::vector<double> t = read_all(f, "/tow/time");
+  const std::vector<double> force = read_all(f, "/tow/force_mean");
+  const std::vector<double> ice = read_all(f, "/tow/ice_force_mean");
+  const std::vector<double> frames = read_all(f, "/time");
+  REQUIRE(t.size() == 1 + 400 / 3 + 1);  // t = 0, every 3rd of 400 steps, and the last
+  CHECK(frames.size() == 5);              // t = 0 and every 100th step
+  CHECK(t[1] == Approx(0.15).epsilon(1e-12));
+  CHECK(t.back() == Approx(20.0).epsilon(1e-12));
+  double impulse = 0.0;
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    CHECK(force[2 * k] == Approx(ice[2 * k]).margin(1e-9 * std::abs(ice[2 * k]) + 1e-6));  // no drag, no inertia
+    impulse += ice[2 * k] * (t[k] - t[k - 1]);
+  }
+  const std::vector<double> velocity = read_all(f, "/bodies/velocity");  // [T, bodies, 2]
+  const double floe_mass = 900.0 * 400.0 * 1.0;
+  const double floe_vx = velocity[velocity.size() - 2];
+  CHECK(floe_vx == Approx(1.5).epsilon(1e-6));  // (1 + e) u against an infinite mass
+  CHECK(impulse == Approx(floe_mass * floe_vx).epsilon(1e-9));
+  fs::remove(out);
+}
