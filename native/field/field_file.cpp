@@ -33,12 +33,41 @@ std::string describe(const ThicknessDistribution& t) {
   return s.str();
 }
 
+Provenance field_provenance(const Field& field, const FieldSpec& spec, double density) {
+  const FieldStats& st = field.stats;
+  return {"/field",
+          {{"method", "power diagram with cells of prescribed areas (damped Newton), Lloyd steps, cells shrunk to the floe areas"},
+           {"thickness", describe(spec.thickness)},
+           {"seed", std::to_string(spec.seed)}},
+          {{"origin_x", spec.origin.x},
+           {"origin_y", spec.origin.y},
+           {"width", spec.width},
+           {"height", spec.height},
+           {"concentration", spec.concentration},
+           {"alpha", spec.alpha},
+           {"d_min", spec.d_min},
+           {"d_max", spec.d_max},
+           {"irregularity", spec.irregularity},
+           {"density", density},
+           {"floes", static_cast<double>(st.floes)},
+           {"free_area", st.free_area},
+           {"ice_area", st.ice_area},
+           {"concentration_achieved", st.concentration},
+           {"alpha_fitted", st.fit.alpha},
+           {"alpha_fitted_stderr", st.fit.stderr_alpha},
+           {"newton_iterations", static_cast<double>(st.newton_iterations)},
+           {"lloyd_steps", static_cast<double>(st.lloyd_steps)},
+           {"max_cell_area_error", st.max_cell_area_error},
+           {"floes_short_of_area", static_cast<double>(st.floes_short_of_area)}}};
+}
+
 void write_field_file(const std::string& path, const Field& field, const FieldSpec& spec, double density,
                       const std::string& floedem_version) {
   Scene scene;
   scene.source_path = path;
   scene.bodies = field_floes(field, density);
   scene.output.contacts = ContactOutput::none;
+  scene.provenance.push_back(field_provenance(field, spec, density));
   scene.derive();
   EngineInfo engine{"none (field generator)", "", {}, {}};
   Recorder recorder(path, scene, engine, RunInfo{{}, floedem_version});
@@ -46,32 +75,6 @@ void write_field_file(const std::string& path, const Field& field, const FieldSp
   state.resize(scene.bodies.size());
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) state.position[i] = scene.bodies[i].centroid;
   recorder.write_frame(0.0, state);
-  const FieldStats& st = field.stats;
-  recorder.annotate(
-      "/field",
-      {{"method", "power diagram with cells of prescribed areas (damped Newton), Lloyd steps, cells shrunk to the floe areas"},
-       {"thickness", describe(spec.thickness)},
-       {"seed", std::to_string(spec.seed)}},
-      {{"origin_x", spec.origin.x},
-       {"origin_y", spec.origin.y},
-       {"width", spec.width},
-       {"height", spec.height},
-       {"concentration", spec.concentration},
-       {"alpha", spec.alpha},
-       {"d_min", spec.d_min},
-       {"d_max", spec.d_max},
-       {"irregularity", spec.irregularity},
-       {"density", density},
-       {"floes", static_cast<double>(st.floes)},
-       {"free_area", st.free_area},
-       {"ice_area", st.ice_area},
-       {"concentration_achieved", st.concentration},
-       {"alpha_fitted", st.fit.alpha},
-       {"alpha_fitted_stderr", st.fit.stderr_alpha},
-       {"newton_iterations", static_cast<double>(st.newton_iterations)},
-       {"lloyd_steps", static_cast<double>(st.lloyd_steps)},
-       {"max_cell_area_error", st.max_cell_area_error},
-       {"floes_short_of_area", static_cast<double>(st.floes_short_of_area)}});
   recorder.write_polygons("/field", "keep_out", spec.keep_out);
   recorder.finish({});
 }

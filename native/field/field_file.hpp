@@ -13,6 +13,10 @@ namespace floedem {
 /// The floes of a field as scene bodies named prefix + index, at rest, of the given density.
 std::vector<BodySpec> field_floes(const Field& field, double density, const std::string& prefix = "field-");
 
+/// The /field attributes: the generator's parameters and what it achieved (a field file's and a
+/// run's output with a generated [field] alike).
+Provenance field_provenance(const Field& field, const FieldSpec& spec, double density);
+
 /// Writes FIELD.h5 (under FIELD.h5.partial until complete). Throws OutputError.
 void write_field_file(const std::string& path, const Field& field, const FieldSpec& spec, double density,
                       const std::string& floedem_version);

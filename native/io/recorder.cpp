@@ -310,6 +310,11 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
       d.tow_ice_mean = Series(tow, "ice_force_mean", H5::PredType::NATIVE_DOUBLE, {2}, kt);
       d.tow_tug = Series(tow, "tug_position", H5::PredType::NATIVE_DOUBLE, {2}, kt);
     }
+    for (const Provenance& p : scene.provenance) {
+      H5::Group g = d.file.createGroup(p.group);
+      for (const auto& [k, v] : p.text) write_attribute(g, k, v);
+      for (const auto& [k, v] : p.numbers) write_attribute(g, k, v);
+    }
     d.flush();
   } catch (const H5::Exception& e) {
     std::error_code ec;
@@ -421,17 +426,6 @@ H5::Group open_or_create(H5::H5File& file, const std::string& group) {
   return file.nameExists(group) ? file.openGroup(group) : file.createGroup(group);
 }
 }  // namespace
-
-void Recorder::annotate(const std::string& group, const std::vector<std::pair<std::string, std::string>>& text,
-                        const std::vector<std::pair<std::string, double>>& numbers) {
-  try {
-    H5::Group g = open_or_create(impl_->file, group);
-    for (const auto& [k, v] : text) write_attribute(g, k, v);
-    for (const auto& [k, v] : numbers) write_attribute(g, k, v);
-  } catch (const H5::Exception& e) {
-    throw OutputError(partial_path_ + ": could not write " + group + " (" + e.getDetailMsg() + ")");
-  }
-}
 
 void Recorder::write_polygons(const std::string& group, const std::string& name,
                               const std::vector<std::vector<Vec2>>& polygons) {

@@ -43,9 +43,6 @@ class Recorder {
   void write_tow(double time, const TowFrame& frame);
   /// Rewrites /engine's attributes (engines report measured figures, e.g. out-of-plane drift).
   void update_engine_info(const EngineInfo& engine);
-  /// Attributes on a group (created when missing), e.g. the parameters of a generated field.
-  void annotate(const std::string& group, const std::vector<std::pair<std::string, std::string>>& text,
-                const std::vector<std::pair<std::string, double>>& numbers);
   /// Polygons as `name_vertices` [V, 2] and `name_offsets` [P + 1] in a group (created when
   /// missing): the layout of /bodies/polygon_vertices and polygon_offsets.
   void write_polygons(const std::string& group, const std::string& name, const std::vector<std::vector<Vec2>>& polygons);

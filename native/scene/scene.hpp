@@ -145,6 +145,14 @@ struct TowSpec {
   Vec2 displacement(double t0, double t1) const;  ///< integral of the path velocity
 };
 
+/// Where part of a scene came from, for the output: attributes of one group (a generated
+/// field's parameters and what it achieved, /field). The recorder writes them as they are.
+struct Provenance {
+  std::string group;
+  std::vector<std::pair<std::string, std::string>> text;
+  std::vector<std::pair<std::string, double>> numbers;
+};
+
 struct Scene {
   std::string source_path;   ///< the scenario file, for messages
   std::string source_text;   ///< its text verbatim (stored in the output)
@@ -157,6 +165,7 @@ struct Scene {
   bool has_environment = false;
   EnvironmentSpec environment;
   TowSpec tow;
+  std::vector<Provenance> provenance;
 
   /// [engine.NAME] tables, kept as written: each engine reads and checks its own.
   std::map<std::string, toml::table> engine_settings;

@@ -3,6 +3,7 @@
 // `floedem field` (exit codes, nothing written on bad input).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -94,6 +95,14 @@ TEST_CASE("scenario [field]: generated around the scenario's bodies, or loaded f
   CHECK_FALSE(find_overlap(scene).has_value());
   const double free_area = 300.0 * 200.0 - scene.bodies[0].area - 1600.0;
   CHECK(std::abs(ice / free_area - 0.5) <= 0.005);
+  // The run's output says how the field was made, and what it achieved.
+  REQUIRE(scene.provenance.size() == 1);
+  CHECK(scene.provenance[0].group == "/field");
+  const auto& numbers = scene.provenance[0].numbers;
+  const auto achieved = std::find_if(numbers.begin(), numbers.end(),
+                                     [](const auto& kv) { return kv.first == "concentration_achieved"; });
+  REQUIRE(achieved != numbers.end());
+  CHECK(achieved->second == Approx(ice / free_area).epsilon(1e-9));
 
   // The same floes through a field file: `file` reads them back in the same order.
   const fs::path d = dir_for("scenario");
