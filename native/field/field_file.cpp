@@ -33,7 +33,7 @@ std::string describe(const ThicknessDistribution& t) {
   return s.str();
 }
 
-Provenance field_provenance(const Field& field, const FieldSpec& spec, double density) {
+Provenance field_provenance(const Field& field, const FieldSpec& spec, double density, std::size_t first_floe) {
   const FieldStats& st = field.stats;
   return {"/field",
           {{"method", "power diagram with cells of prescribed areas (damped Newton), Lloyd steps, cells shrunk to the floe areas"},
@@ -50,6 +50,7 @@ Provenance field_provenance(const Field& field, const FieldSpec& spec, double de
            {"irregularity", spec.irregularity},
            {"density", density},
            {"floes", static_cast<double>(st.floes)},
+           {"first_floe", static_cast<double>(first_floe)},
            {"free_area", st.free_area},
            {"ice_area", st.ice_area},
            {"concentration_achieved", st.concentration},
@@ -67,7 +68,7 @@ void write_field_file(const std::string& path, const Field& field, const FieldSp
   scene.source_path = path;
   scene.bodies = field_floes(field, density);
   scene.output.contacts = ContactOutput::none;
-  scene.provenance.push_back(field_provenance(field, spec, density));
+  scene.provenance.push_back(field_provenance(field, spec, density, 0));
   scene.derive();
   EngineInfo engine{"none (field generator)", "", {}, {}};
   Recorder recorder(path, scene, engine, RunInfo{{}, floedem_version});

@@ -14,8 +14,9 @@ namespace floedem {
 std::vector<BodySpec> field_floes(const Field& field, double density, const std::string& prefix = "field-");
 
 /// The /field attributes: the generator's parameters and what it achieved (a field file's and a
-/// run's output with a generated [field] alike).
-Provenance field_provenance(const Field& field, const FieldSpec& spec, double density);
+/// run's output with a generated [field] alike). `first_floe`: the index of the field's first
+/// body (0 in a field file; after the scenario's own [[body]] entries in a run).
+Provenance field_provenance(const Field& field, const FieldSpec& spec, double density, std::size_t first_floe);
 
 /// Writes FIELD.h5 (under FIELD.h5.partial until complete). Throws OutputError.
 void write_field_file(const std::string& path, const Field& field, const FieldSpec& spec, double density,

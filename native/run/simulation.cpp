@@ -125,7 +125,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                    {"collision_impulses", static_cast<double>(summary.collision_impulses)},
                    {"resting_impulses", static_cast<double>(summary.resting_impulses)},
                    {"collision_events", static_cast<double>(summary.collision_events)},
-                   {"max_peak_force", summary.max_peak_force}});
+                   {"max_peak_force", summary.max_peak_force},
+                   {"wall_seconds", summary.wall_seconds}});
   return summary;
 }
 

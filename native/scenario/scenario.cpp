@@ -459,7 +459,7 @@ void read_field(TableReader& root, Scene& scene, double ice_density, const DragC
       r.fail(p.starts_with("keep_out") ? "keep_out" : p.starts_with("thickness") ? "thickness" : p, e.what());
     }
     floes = field_floes(field, density, prefix);
-    scene.provenance.push_back(field_provenance(field, spec, density));
+    scene.provenance.push_back(field_provenance(field, spec, density, scene.bodies.size()));
     const Vec2 velocity = r.vec2("velocity", Vec2{});
     for (BodySpec& b : floes) b.velocity = velocity;
   }
