@@ -617,6 +617,12 @@ Field generate_field(const FieldSpec& spec) {
     const AreaMoments m0 = area_moments(cell);
     cell = clean_convex(std::move(cell), 1e-4 * std::sqrt(m0.area));
     const AreaMoments m = area_moments(cell);
+    // A sliver left by a keep-out cut can clean to a segment (no area): no floe, counted short
+    // (shrinking it would divide 0 by 0; found by a 600 m x 400 m field round an iceberg).
+    if (cell.size() < 3 || !(m.area > 0.0)) {
+      ++field.stats.floes_short_of_area;
+      continue;
+    }
     double a = floe_area[i];
     if (m.area < a) {
       // Only a keep-out cut can leave a cell short of its floe (the weights are solved to 1e-6).

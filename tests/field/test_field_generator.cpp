@@ -160,6 +160,31 @@ TEST_CASE("field: keep-out zones stay free and the concentration holds on the fr
     for (const auto& k : pieces) REQUIRE(test::convex_interiors_disjoint(p, k));
 }
 
+TEST_CASE("field: a keep-out cut that leaves a sliver gives no floe, never a degenerate one", "[field]") {
+  // Regression: the towing case's iceberg in a 600 m x 400 m field (seed 2016) left one cell
+  // cleaned to a segment; it was shrunk by 0 / 0 into a NaN floe that crashed the convex partition.
+  FieldSpec s;
+  s.origin = {-150.0, -200.0};
+  s.width = 600.0;
+  s.height = 400.0;
+  s.concentration = 0.5;
+  s.alpha = 2.0;
+  s.d_min = 5.0;
+  s.d_max = 60.0;
+  s.thickness.value = 1.16;
+  s.seed = 2016;
+  s.keep_out = {{{-90, -55}, {-20, -62}, {60, -58}, {92, -20}, {88, 35}, {40, 62}, {5, 40}, {-30, 60}, {-85, 45}, {-95, 0}}};
+  const Field f = generate_field(s);
+  CHECK(f.stats.floes_short_of_area >= 1);
+  for (const auto& p : f.floes) {
+    REQUIRE(p.size() >= 3);
+    for (const Vec2 v : p) REQUIRE((std::isfinite(v.x) && std::isfinite(v.y)));
+    REQUIRE(is_strictly_convex(p));
+    REQUIRE(signed_area(p) > 0.0);
+  }
+  CHECK(std::abs(f.stats.concentration - 0.5) <= 0.005);
+}
+
 TEST_CASE("field: bad parameters name the parameter and the allowed range", "[field][input]") {
   struct Bad {
     const char* parameter;
