@@ -21,15 +21,28 @@ from floedem_h5 import (body_polygons, equal_area_diameters, polygons,  # noqa: 
                         truncated_power_law_survival)
 
 
-def draw_field(f, out):
+def field_bodies(f):
+    """The range of body indices that are the field's floes (a run's output has the
+    scenario's own bodies first)."""
+    g = f["field"].attrs
+    first = int(g.get("first_floe", 0))
+    return first, first + int(g["floes"])
+
+
+def draw_field(f, out, title=None):
     g = f["field"].attrs
     x0, y0, w, h = g["origin_x"], g["origin_y"], g["width"], g["height"]
-    floes = body_polygons(f, 0)
+    a, b = field_bodies(f)
+    bodies = body_polygons(f, 0)
+    floes = bodies[a:b]
     size = 9.0
     fig, ax = plt.subplots(figsize=(size, size * h / w + 0.8))
     ax.add_collection(PolyCollection(floes, facecolors="#c6dbef", edgecolors="#08306b",
                                      linewidths=0.3 if len(floes) < 5000 else 0.08))
-    for zone in polygons(f, "field", "keep_out"):
+    others = bodies[:a] + bodies[b:]
+    if others:
+        ax.add_collection(PolyCollection(others, facecolors="0.35", edgecolors="k", linewidths=0.5))
+    for zone in polygons(f, "field", "keep_out") if "field/keep_out_vertices" in f else []:
         ax.add_patch(Polygon(zone, closed=True, fill=False, hatch="//", edgecolor="0.4", linewidth=0.8))
     ax.add_patch(Rectangle((x0, y0), w, h, fill=False, edgecolor="k", linewidth=1.0))
     ax.set_xlim(x0 - 0.02 * w, x0 + 1.02 * w)
@@ -37,8 +50,8 @@ def draw_field(f, out):
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(f"{len(floes)} floes, concentration {g['concentration_achieved']:.4f} "
-                 f"(target {g['concentration']:.3f}), seed {g['seed']}")
+    ax.set_title(title or f"{len(floes)} floes, concentration {g['concentration_achieved']:.4f} "
+                          f"(target {g['concentration']:.3f}), seed {g['seed']}")
     fig.tight_layout()
     fig.savefig(out, dpi=110 if len(floes) < 20000 else 250)
     plt.close(fig)
@@ -46,7 +59,8 @@ def draw_field(f, out):
 
 def draw_sizes(f, out):
     g = f["field"].attrs
-    d = np.sort(equal_area_diameters(f))
+    a, b = field_bodies(f)
+    d = np.sort(equal_area_diameters(f)[a:b])
     n = len(d)
     survival = 1.0 - (np.arange(n) + 0.5) / n  # fraction larger than d (midpoint plotting positions)
     grid = np.geomspace(g["d_min"], g["d_max"], 200)

@@ -1,7 +1,5 @@
 #include "app/field_command.hpp"
-
-#include <spawn.h>
-#include <sys/wait.h>
+#include "app/python_script.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -12,8 +10,6 @@
 #include "field/field_file.hpp"
 #include "scene/input_error.hpp"
 #include "version.hpp"
-
-extern char** environ;
 
 namespace floedem {
 namespace {
@@ -51,28 +47,11 @@ std::vector<Vec2> parse_polygon(const std::string& text) {
 
 /// Runs the figure script: FIELD.png (the floes) and FIELD-sizes.png (size survival, fit).
 int draw(const std::string& field_file, const std::string& png) {
-  const std::string python = FLOEDEM_PYTHON_EXE;
-  if (python.empty()) {
-    std::cerr << "floedem: error: --plot needs Python 3 with numpy, h5py and matplotlib, which the build did not find\n";
-    return 1;
-  }
-  const std::string script = std::string(FLOEDEM_REPORTS_DIR) + "/plot_field.py";
-  std::vector<std::string> args{python, script, field_file, "--out", png};
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv.data(), environ) != 0) {
-    std::cerr << "floedem: error: cannot start " << python << "\n";
-    return 1;
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::cerr << "floedem: error: " << script << " failed; the field file " << field_file << " is complete\n";
-    return 1;
-  }
-  return 0;
+  const int status = run_python_script("plot_field.py", {field_file, "--out", png});
+  if (status == 0) return 0;
+  if (status > 0)
+    std::cerr << "floedem: error: reports/plot_field.py failed; the field file " << field_file << " is complete\n";
+  return 1;
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // floedem command line. Exit codes: 0 done; 1 unexpected error; 2 bad input (scenario,
-// options, engine settings); 3 output could not be written; 4 the solver failed.
+// options, engine settings); 3 output could not be written; 4 the solver failed (report: a run
+// failed); 5 report: the engines disagree beyond the documented tolerances.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -7,6 +8,7 @@
 #include <iostream>
 
 #include "app/field_command.hpp"
+#include "app/python_script.hpp"
 #include "engine/registry.hpp"
 #include "io/recorder.hpp"
 #include "run/simulation.hpp"
@@ -57,6 +59,17 @@ int main(int argc, char** argv) {
 
   CLI::App* list = app.add_subcommand("engines", "list the engines this build has");
 
+  std::string report_out = "results/report";
+  bool report_quick = false;
+  int report_jobs = 0;
+  CLI::App* report = app.add_subcommand(
+      "report", "run the scenario suite on every engine and write DIR/REPORT.md with its figures (reports/report.py)");
+  report->add_option("--out,-o", report_out, "report directory (its fig/ and runs/ are replaced)")->capture_default_str();
+  report->add_flag("--quick", report_quick,
+                   "the same sections on smaller, shorter cases (the CI cross-check; a few minutes on 2 cores)");
+  report->add_option("--jobs,-j", report_jobs, "runs at a time (default: the number of cores)")
+      ->check(CLI::PositiveNumber);
+
   floedem::FieldCommand field_options;
   CLI::App* field = floedem::add_field_command(app, field_options);
 
@@ -73,6 +86,14 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (field->parsed()) return floedem::run_field_command(field_options);
+    if (report->parsed()) {
+      // Exit status as the script's: 0 agreement, 5 disagreement, 4 a run failed.
+      std::vector<std::string> args{"--floedem", floedem::own_executable(), "--out", report_out};
+      if (report_quick) args.emplace_back("--quick");
+      if (report_jobs > 0) args.insert(args.end(), {"--jobs", std::to_string(report_jobs)});
+      const int status = floedem::run_python_script("report.py", args);
+      return status < 0 ? 1 : status;
+    }
     return run_command(scenario, engine, output, overrides, quiet);
   } catch (const floedem::InputError& e) {
     std::cerr << "floedem: error: " << e.what() << "\n";

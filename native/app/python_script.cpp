@@ -1,0 +1,42 @@
+#include "app/python_script.hpp"
+
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <iostream>
+
+extern char** environ;
+
+namespace floedem {
+
+int run_python_script(const std::string& script, const std::vector<std::string>& args) {
+  const std::string python = FLOEDEM_PYTHON_EXE;
+  if (python.empty()) {
+    std::cerr << "floedem: error: " << script
+              << " needs Python 3 with numpy, h5py and matplotlib, which the build did not find\n";
+    return -1;
+  }
+  std::vector<std::string> all{python, std::string(FLOEDEM_REPORTS_DIR) + "/" + script};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv.data(), environ) != 0) {
+    std::cerr << "floedem: error: cannot start " << python << "\n";
+    return -1;
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+std::string own_executable() {
+  std::error_code ec;
+  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("floedem") : p.string();
+}
+
+}  // namespace floedem

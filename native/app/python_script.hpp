@@ -1,0 +1,16 @@
+#pragma once
+// The figure and report scripts of reports/, run with the Python the build found
+// (Debian's python3 with numpy, h5py and matplotlib).
+#include <string>
+#include <vector>
+
+namespace floedem {
+
+/// Runs reports/SCRIPT with the arguments, waits for it; its output goes to ours. Returns its
+/// exit status, or -1 with a message on stderr when Python is missing or cannot start.
+int run_python_script(const std::string& script, const std::vector<std::string>& args);
+
+/// This executable's own path (for scripts that call floedem back).
+std::string own_executable();
+
+}  // namespace floedem

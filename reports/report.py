@@ -1,0 +1,132 @@
+#!/usr/bin/env python3
+"""The cross-engine report: runs the scenario suite on every engine (a progress line per
+run), then writes OUT/REPORT.md with its figures in OUT/fig and the runs in OUT/runs. Every
+figure and table is made here from the runs made here. Exit status: 0 when the engines agree
+within the documented tolerances, 5 when they do not (each disagreement printed, the report
+written all the same), 4 when a run failed (no report written).
+
+`floedem report [--quick] [--out DIR]` runs this (the README's main job).
+
+usage: report.py [--floedem build/floedem] [--out results/report] [--quick] [--jobs N]
+"""
+import argparse
+import datetime
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+from report_runner import run_all  # noqa: E402
+from sections import SECTIONS  # noqa: E402
+
+
+class Context:
+    """What every section sees: the options, where things go, and the runs by tag."""
+
+    def __init__(self, a, engines):
+        self.floedem = a.floedem
+        self.quick = a.quick
+        self.out = os.path.abspath(a.out)
+        self.fig = os.path.join(self.out, "fig")
+        self.runs_dir = os.path.join(self.out, "runs")
+        self.scenarios = os.path.join(ROOT, "scenarios")
+        self.engines = engines          # native first
+        self.all_runs = []
+
+    def run(self, tag):
+        for r in self.all_runs:
+            if r.tag == tag:
+                return r
+        raise KeyError(f"report: no run {tag}")
+
+
+def floedem_text(floedem, *args):
+    return subprocess.run([floedem, *args], capture_output=True, text=True, check=True).stdout
+
+
+def git_commit():
+    try:
+        c = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+        d = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
+                           capture_output=True, text=True)
+        return c.stdout.strip() + (" (with uncommitted changes)" if d.stdout.strip() else "") if c.returncode == 0 \
+            else "unknown (not a git checkout)"
+    except OSError:
+        return "unknown (no git)"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--floedem", default=os.path.join(ROOT, "build", "floedem"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "results", "report"))
+    ap.add_argument("--quick", action="store_true",
+                    help="the same sections on smaller and shorter cases (the CI cross-check, a few minutes)")
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time (default: the cores)")
+    a = ap.parse_args()
+    start = time.monotonic()
+    listed = [line.split("\t")[0] for line in floedem_text(a.floedem, "engines").splitlines() if line.strip()]
+    engines = ["native"] + [e for e in listed if e != "native"]
+    ctx = Context(a, engines)
+    for d in (ctx.fig, ctx.runs_dir):
+        shutil.rmtree(d, ignore_errors=True)   # nothing in the report may come from an earlier run
+        os.makedirs(d)
+    report = os.path.join(ctx.out, "REPORT.md")
+    if os.path.exists(report):
+        os.remove(report)
+
+    seen = {}
+    for section in SECTIONS:
+        for r in section.plan(ctx):
+            if r.tag in seen:
+                if seen[r.tag].command("x") != r.command("x"):
+                    raise SystemExit(f"report: two sections ask for run {r.tag} differently")
+                continue
+            seen[r.tag] = r
+            ctx.all_runs.append(r)
+    print(f"report: {len(ctx.all_runs)} runs on {', '.join(engines)}, {a.jobs} at a time, into {ctx.runs_dir}",
+          flush=True)
+    failed = run_all(ctx.all_runs, a.floedem, ctx.runs_dir, a.jobs, "report")
+    if failed:
+        for r in failed:
+            print(f"report: run {r.tag} failed: {r.error}", file=sys.stderr)
+        print(f"report: {len(failed)} runs failed; no REPORT.md written", file=sys.stderr)
+        return 4
+    run_seconds = time.monotonic() - start
+
+    body, fails = [], []
+    for section in SECTIONS:
+        md, f = section.write(ctx)
+        body += md
+        fails += f
+    total = time.monotonic() - start
+    version = floedem_text(a.floedem, "--version").strip()
+    head = [f"# floedem cross-engine report{' (--quick)' if a.quick else ''}", "",
+            f"Written {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC by `floedem report"
+            f"{' --quick' if a.quick else ''}` ({version}, commit {git_commit()}) on {platform.node()} "
+            f"({os.cpu_count()} cores, {a.jobs} runs at a time): {len(ctx.all_runs)} runs in {run_seconds:.0f} s, "
+            f"{total:.0f} s in all. Every table and figure below comes from the HDF5 files of those runs, in "
+            "`runs/` (each table names its files); none is typed or kept from an earlier report.", "",
+            "## Cross-check", ""]
+    if fails:
+        head += [f"**{len(fails)} disagreements beyond the documented tolerances:**", ""] + [f"- {x}" for x in fails]
+    else:
+        head += ["Every engine agrees with native, and native with the closed forms, within the tolerances stated "
+                 "in each section."]
+    head.append("")
+    tmp = report + ".partial"
+    with open(tmp, "w") as f:
+        f.write("\n".join(head + body) + "\n")
+    os.replace(tmp, report)
+    for x in fails:
+        print(f"report: DISAGREEMENT: {x}", file=sys.stderr)
+    print(f"report: {report} ({len(fails)} disagreements, {total:.0f} s)", flush=True)
+    return 5 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
