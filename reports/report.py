@@ -69,6 +69,8 @@ def main():
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time (default: the cores)")
     a = ap.parse_args()
     start = time.monotonic()
+    commit = git_commit()   # now: the tree the runs are made from
+    version = floedem_text(a.floedem, "--version").strip()
     listed = [line.split("\t")[0] for line in floedem_text(a.floedem, "engines").splitlines() if line.strip()]
     engines = ["native"] + [e for e in listed if e != "native"]
     ctx = Context(a, engines)
@@ -104,10 +106,9 @@ def main():
         body += md
         fails += f
     total = time.monotonic() - start
-    version = floedem_text(a.floedem, "--version").strip()
     head = [f"# floedem cross-engine report{' (--quick)' if a.quick else ''}", "",
             f"Written {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC by `floedem report"
-            f"{' --quick' if a.quick else ''}` ({version}, commit {git_commit()}) on {platform.node()} "
+            f"{' --quick' if a.quick else ''}` ({version}, source commit {commit}) on {platform.node()} "
             f"({os.cpu_count()} cores, {a.jobs} runs at a time): {len(ctx.all_runs)} runs in {run_seconds:.0f} s, "
             f"{total:.0f} s in all. Every table and figure below comes from the HDF5 files of those runs, in "
             "`runs/` (each table names its files); none is typed or kept from an earlier report.", "",
