@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The main job: installs what is missing, builds, and runs the default scenario on every
-# engine (native, box2d, bullet, ode), printing each run's summary. Outputs go to results/.
-# (The cross-engine report, `floedem report`, will end this job once it exists.)
+# The main job: installs what is missing, builds, runs the default scenario on every engine
+# (native, box2d, bullet, ode), printing each run's summary, and ends with the cross-engine
+# report (`floedem report`: about 30 minutes on 2 cores). Outputs go to results/; the report to
+# results/report/REPORT.md.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$root/scripts/setup.sh"
@@ -11,3 +12,4 @@ mkdir -p "$root/results"
 for engine in $("$build/floedem" engines | cut -f1); do
   "$build/floedem" run "$root/scenarios/default.toml" --engine "$engine" --out "$root/results/default.$engine.h5"
 done
+"$build/floedem" report --out "$root/results/report"

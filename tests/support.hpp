@@ -21,8 +21,9 @@ struct CliResult {
   int code;
   std::string output;
 };
-inline CliResult run_cli(const std::string& args) {
-  const std::string cmd = std::string(FLOEDEM_EXE) + " " + args + " 2>&1";
+/// Runs `floedem ARGS` through /bin/sh, after `shell_prefix` (e.g. "ulimit -f 100; ").
+inline CliResult run_cli(const std::string& args, const std::string& shell_prefix = "") {
+  const std::string cmd = shell_prefix + std::string(FLOEDEM_EXE) + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   std::array<char, 4096> buf{};

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -100,7 +101,11 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const floedem::OutputError& e) {
     std::cerr << "floedem: output error: " << e.what() << "\n";
-    return 3;
+    // After a failed write (disk full) HDF5 still holds the file open in an inconsistent state,
+    // and its exit handler would crash closing it: leave without running the exit handlers.
+    std::cout.flush();
+    std::cerr.flush();
+    std::_Exit(3);
   } catch (const floedem::SolverFailure& e) {
     std::cerr << "floedem: solver failure: " << e.what() << "\n";
     return 4;

@@ -1,5 +1,7 @@
 #include "io/recorder.hpp"
 
+#include <sys/statvfs.h>
+
 #include <H5Cpp.h>
 
 #include <algorithm>
@@ -127,6 +129,7 @@ struct Recorder::Impl {
   std::vector<double> w_time, w_force, w_mean, w_ice, w_tug;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false;
+  bool write_failed = false;
 
   void write_buffers() {
     if (buffered_frames > 0) {
@@ -199,6 +202,7 @@ struct Recorder::Impl {
 Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo& engine, const RunInfo& run)
     : impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
   H5::Exception::dontPrint();
+  check_space(scene);
   try {
     Impl& d = *impl_;
     d.file = H5::H5File(partial_path_, H5F_ACC_TRUNC);
@@ -324,9 +328,32 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
   }
 }
 
+void Recorder::check_space(const Scene& scene) const {
+  // The frames' size is known before the run: 6 doubles per body and frame (position, angle,
+  // velocity, angular velocity), plus /tow's 9 per row. A disk too small for them is told now,
+  // not hours into the run (contact rows depend on the run and are not counted).
+  const double steps = static_cast<double>(scene.run.steps());
+  const double frames = steps / scene.run.output_every + 2.0;
+  const int tow_every = scene.output.tow_every > 0 ? scene.output.tow_every : scene.run.output_every;
+  const double tow_rows = scene.tow.mode == TowSpec::Mode::none ? 0.0 : steps / tow_every + 2.0;
+  const double bytes = 8.0 * (frames * (6.0 * static_cast<double>(scene.bodies.size()) + 1.0) + 9.0 * tow_rows);
+  const std::filesystem::path dir = std::filesystem::absolute(path_).parent_path();
+  struct statvfs fs {};
+  if (statvfs(dir.c_str(), &fs) != 0) return;  // a missing directory is reported on creation
+  const double free_bytes = static_cast<double>(fs.f_bavail) * static_cast<double>(fs.f_frsize);
+  if (bytes > free_bytes) {
+    char text[256];
+    std::snprintf(text, sizeof text, ": the frames alone need about %.3g MB and %.3g MB are free there", bytes / 1e6,
+                  free_bytes / 1e6);
+    throw OutputError(path_ + text + " (fewer frames: a larger run.output_every)");
+  }
+}
+
 Recorder::~Recorder() {
-  // A run that did not finish: keep what was recorded, readable, under the .partial name.
-  if (impl_ && !impl_->closed) {
+  // A run that did not finish: keep what was recorded, readable, under the .partial name
+  // (not after a failed write: the file cannot be made consistent then, and HDF5 would only
+  // fail again).
+  if (impl_ && !impl_->closed && !impl_->write_failed) {
     try {
       impl_->flush();
       impl_->file.close();
@@ -351,7 +378,8 @@ void Recorder::write_frame(double time, const BodyStates& state) {
     if (d.buffered_frames >= d.frame_chunk) d.write_buffers();
     d.maybe_flush();
   } catch (const H5::Exception& e) {
-    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full?");
+    impl_->write_failed = true;
+    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
   }
 }
 
@@ -376,7 +404,8 @@ void Recorder::write_contacts(double time, std::span<const ContactRecord> contac
   try {
     if (d.k_time.size() >= 4096) d.write_buffers();
   } catch (const H5::Exception& e) {
-    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full?");
+    impl_->write_failed = true;
+    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
   }
 }
 
@@ -387,7 +416,8 @@ void Recorder::write_collisions(std::span<const CollisionRow> rows) {
     if (d.events.size() >= 1024) d.write_buffers();
     d.maybe_flush();
   } catch (const H5::Exception& e) {
-    throw OutputError(partial_path_ + ": could not write collisions (" + e.getDetailMsg() + "); disk full?");
+    impl_->write_failed = true;
+    throw OutputError(partial_path_ + ": could not write collisions (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
   }
 }
 
@@ -457,7 +487,8 @@ void Recorder::finish(const std::vector<std::pair<std::string, double>>& summary
     d.file.close();
     d.closed = true;
   } catch (const H5::Exception& e) {
-    throw OutputError(partial_path_ + ": could not complete the file (" + e.getDetailMsg() + "); disk full?");
+    impl_->write_failed = true;
+    throw OutputError(partial_path_ + ": could not complete the file (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
   }
   if (std::rename(partial_path_.c_str(), path_.c_str()) != 0)
     throw OutputError(partial_path_ + ": cannot rename to " + path_ + ": " + std::strerror(errno));

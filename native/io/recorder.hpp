@@ -55,6 +55,8 @@ class Recorder {
   std::int64_t collision_rows() const;
 
  private:
+  /// OutputError when the file system cannot hold the frames the scene will record.
+  void check_space(const Scene& scene) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::string path_;

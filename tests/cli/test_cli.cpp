@@ -74,6 +74,36 @@ TEST_CASE("cli: an unwritable output exits 3", "[cli]") {
   CHECK(r.output.find("/nonexistent-dir/r.h5") != std::string::npos);
 }
 
+TEST_CASE("cli: a disk that fills during the run exits 3, and nothing lies under the final name", "[cli]") {
+  // A file-size limit stands in for a full disk: with SIGXFSZ ignored, write() fails (EFBIG) as
+  // it would with ENOSPC. 2 MB holds the start of drift_in_floes (30 bodies, 3600 frames: ~5 MB).
+  const fs::path d = fs::temp_directory_path() / ("floedem-full-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/drift_in_floes.toml";
+  const fs::path out = d / "r.h5";
+  const Result r = floedem::test::run_cli("run " + scenario + " -q --out " + out.string(), "trap '' XFSZ; ulimit -f 2000; ");
+  INFO(r.output);
+  CHECK(r.code == 3);
+  CHECK(r.output.find("disk full?") != std::string::npos);
+  CHECK(r.output.find(out.string() + ".partial") != std::string::npos);
+  CHECK_FALSE(fs::exists(out));
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: a disk too small for the frames is told before the run, exit 3", "[cli]") {
+  // /dev/shm or /tmp cannot hold 1e12 frames of a 36-floe scene: refused at once, nothing made.
+  const fs::path d = fs::temp_directory_path() / ("floedem-small-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/default.toml";
+  const fs::path out = d / "r.h5";
+  const Result r = run("run " + scenario + " -q --set run.duration=1e9 --set run.dt=0.001 --out " + out.string());
+  INFO(r.output);
+  CHECK(r.code == 3);
+  CHECK(r.output.find("frames alone need") != std::string::npos);
+  CHECK(fs::is_empty(d));
+  fs::remove_all(d);
+}
+
 TEST_CASE("cli: help lists the commands and options", "[cli]") {
   Result r = run("--help");
   CHECK(r.code == 0);
