@@ -93,6 +93,8 @@ def main():
     print(f"report: {len(ctx.all_runs)} runs on {', '.join(engines)}, {a.jobs} at a time, into {ctx.runs_dir}",
           flush=True)
     failed = run_all(ctx.all_runs, a.floedem, ctx.runs_dir, a.jobs, "report")
+    # The stress suite's runs may fail (a non-finite state is one of its outcomes): not an error.
+    failed = [r for r in failed if not r.meta.get("may_fail")]
     if failed:
         for r in failed:
             print(f"report: run {r.tag} failed: {r.error}", file=sys.stderr)

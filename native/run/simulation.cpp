@@ -91,6 +91,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     ended.clear();
   };
   Progress progress(options.progress);
+  double overlap_sum = 0.0;
+  std::int64_t overlaps = 0;
+  // Without forcing or towing nothing may add energy: the largest kinetic energy of the run is
+  // then a check (recorded, summary_max_kinetic_energy); with forcing it is not, and not computed.
+  const bool track_energy = stepper.forcing().names().empty() && !tow.active();
+  summary.max_kinetic_energy = summary.kinetic_energy_start;
   for (std::int64_t k = 1; k <= steps; ++k) {
     stepper.step();
     const double t_end = stepper.time();
@@ -99,8 +105,17 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
       throw SolverFailure("non-finite body state at step " + std::to_string(k) + " (t = " + std::to_string(t_end) +
                           " s); output so far kept in " + recorder.partial_path());
     const auto contacts = stepper.contacts();
-    for (const ContactRecord& c : contacts)
+    for (const ContactRecord& c : contacts) {
       ++(c.kind == ContactKind::collision ? summary.collision_impulses : summary.resting_impulses);
+      if (c.separation < 0.0) {
+        summary.max_penetration = std::max(summary.max_penetration, -c.separation);
+        overlap_sum -= c.separation;
+        ++overlaps;
+      }
+    }
+    // Stability figures for the stress suite: cheap (one pass over the bodies).
+    for (const Vec2 v : state.velocity) summary.max_speed_seen = std::max(summary.max_speed_seen, length_squared(v));
+    if (track_energy) summary.max_kinetic_energy = std::max(summary.max_kinetic_energy, kinetic_energy(scene, state));
     recorder.write_contacts(t_end, contacts);
     collisions.observe(t_end, contacts, state, ended);
     if (!ended.empty()) record_collisions();
@@ -114,6 +129,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const BodyStates& state = stepper.state();
   summary.steps = steps;
   summary.kinetic_energy_end = kinetic_energy(scene, state);
+  summary.max_speed_seen = std::sqrt(summary.max_speed_seen);
+  summary.mean_penetration = overlaps > 0 ? overlap_sum / static_cast<double>(overlaps) : 0.0;
+  if (!track_energy) summary.max_kinetic_energy = std::numeric_limits<double>::quiet_NaN();
   for (const Vec2 v : state.velocity) summary.max_speed = std::max(summary.max_speed, length(v));
   summary.frames = recorder.frames();
   summary.contact_rows = recorder.contact_rows();
@@ -126,6 +144,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                    {"resting_impulses", static_cast<double>(summary.resting_impulses)},
                    {"collision_events", static_cast<double>(summary.collision_events)},
                    {"max_peak_force", summary.max_peak_force},
+                   {"max_speed", summary.max_speed_seen},
+                   {"max_penetration", summary.max_penetration},
+                   {"mean_penetration", summary.mean_penetration},
+                   {"max_kinetic_energy", summary.max_kinetic_energy},
                    {"wall_seconds", summary.wall_seconds}});
   return summary;
 }

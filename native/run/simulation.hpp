@@ -35,6 +35,10 @@ struct RunSummary {
   double kinetic_energy_start = 0.0;  ///< J, translational + rotational, moving bodies
   double kinetic_energy_end = 0.0;
   double max_speed = 0.0;             ///< m/s, largest centroid speed at the end
+  double max_speed_seen = 0.0;        ///< m/s, largest centroid speed after any step
+  double max_penetration = 0.0;       ///< m, deepest overlap at the start of a step, any contact
+  double mean_penetration = 0.0;      ///< m, mean overlap over the contact points that overlap
+  double max_kinetic_energy = 0.0;    ///< J, largest kinetic energy after any step
   double wall_seconds = 0.0;
 };
 
