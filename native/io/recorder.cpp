@@ -127,6 +127,9 @@ struct Recorder::Impl {
   bool tow = false;
   Series tow_time, tow_force, tow_force_mean, tow_ice_mean, tow_tug;
   std::vector<double> w_time, w_force, w_mean, w_ice, w_tug;
+  // Contact loads.
+  Series load_time, load_force;
+  std::vector<double> l_time, l_force;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false;
   bool write_failed = false;
@@ -149,6 +152,11 @@ struct Recorder::Impl {
       tow_ice_mean.append(w_ice.data(), n);
       tow_tug.append(w_tug.data(), n);
       w_time.clear(); w_force.clear(); w_mean.clear(); w_ice.clear(); w_tug.clear();
+    }
+    if (!l_time.empty()) {
+      load_time.append(l_time.data(), l_time.size());
+      load_force.append(l_force.data(), l_time.size());
+      l_time.clear(); l_force.clear();
     }
     const hsize_t rows = k_time.size();
     if (rows > 0) {
@@ -314,6 +322,15 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
       d.tow_ice_mean = Series(tow, "ice_force_mean", H5::PredType::NATIVE_DOUBLE, {2}, kt);
       d.tow_tug = Series(tow, "tug_position", H5::PredType::NATIVE_DOUBLE, {2}, kt);
     }
+    if (!scene.output.load_bodies.empty()) {
+      H5::Group loads = d.file.createGroup("/loads");
+      const hsize_t nb = scene.output.load_bodies.size();
+      std::vector<std::int32_t> which;
+      for (const std::size_t i : scene.output.load_bodies) which.push_back(static_cast<std::int32_t>(i));
+      write_fixed(loads, "body", H5::PredType::NATIVE_INT32, which, {nb});
+      d.load_time = Series(loads, "time", H5::PredType::NATIVE_DOUBLE, {}, 1024);
+      d.load_force = Series(loads, "force", H5::PredType::NATIVE_DOUBLE, {nb, 2}, 1024);
+    }
     for (const Provenance& p : scene.provenance) {
       H5::Group g = d.file.createGroup(p.group);
       for (const auto& [k, v] : p.text) write_attribute(g, k, v);
@@ -423,6 +440,13 @@ void Recorder::write_collisions(std::span<const CollisionRow> rows) {
 
 std::int64_t Recorder::collision_rows() const {
   return static_cast<std::int64_t>(impl_->e_time.rows() + impl_->events.size());
+}
+
+void Recorder::write_loads(double time, std::span<const Vec2> forces) {
+  Impl& d = *impl_;
+  d.l_time.push_back(time);
+  for (const Vec2 f : forces) d.l_force.insert(d.l_force.end(), {f.x, f.y});
+  if (d.l_time.size() >= 4096) d.write_buffers();
 }
 
 void Recorder::write_tow(double time, const TowFrame& f) {

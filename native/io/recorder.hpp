@@ -41,6 +41,8 @@ class Recorder {
   void write_collisions(std::span<const CollisionRow> rows);
   /// /tow at a frame: force of the last step, mean force since the last frame, tug position.
   void write_tow(double time, const TowFrame& frame);
+  /// A row of /loads: the mean contact force on each body of [output] loads.
+  void write_loads(double time, std::span<const Vec2> forces);
   /// Rewrites /engine's attributes (engines report measured figures, e.g. out-of-plane drift).
   void update_engine_info(const EngineInfo& engine);
   /// Polygons as `name_vertices` [V, 2] and `name_offsets` [P + 1] in a group (created when

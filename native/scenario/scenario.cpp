@@ -141,6 +141,13 @@ void read_output(TableReader& root, Scene& scene) {
   scene.output.contacts = c == "all" ? ContactOutput::all : c == "collisions" ? ContactOutput::collisions
                                                                              : ContactOutput::none;
   scene.output.tow_every = static_cast<int>(r.integer("tow_every", 0, 1, 1'000'000'000));
+  for (const std::string& name : r.strings("loads")) {
+    std::size_t i = 0;
+    while (i < scene.bodies.size() && scene.bodies[i].name != name) ++i;
+    if (i == scene.bodies.size()) r.fail("loads", "no body is named \"" + name + "\"; allowed the names of bodies");
+    scene.output.load_bodies.push_back(i);
+  }
+  scene.output.load_every = static_cast<int>(r.integer("load_every", 0, 1, 1'000'000'000));
   r.reject_unknown();
 }
 
@@ -504,10 +511,10 @@ Scene parse_scenario(const std::string& text, const std::string& path, const std
   TableReader root(doc, path, "");
   read_run(root, scene);
   read_contact(root, scene);
-  read_output(root, scene);
   const EnvironmentDefaults defaults = read_environment(root, scene);
   read_bodies(root, scene, defaults.ice_density, defaults.floe, defaults.iceberg);
   read_field(root, scene, defaults.ice_density, defaults.floe);
+  read_output(root, scene);  // after the bodies: [output] loads names them
   if (scene.bodies.empty()) root.fail("body", "no [[body]] and no [field] given; allowed at least one body");
   read_tow(root, scene);
   read_engines(root, scene);

@@ -131,6 +131,19 @@ std::string TableReader::string(std::string_view key, std::optional<std::string>
   return v;
 }
 
+std::vector<std::string> TableReader::strings(std::string_view key) {
+  const toml::node* n = lookup(key);
+  std::vector<std::string> out;
+  if (!n) return out;
+  const toml::array* a = n->as_array();
+  if (!a) fail(key, "expected an array of strings, got " + type_name(*n));
+  for (const toml::node& e : *a) {
+    if (!e.is_string()) fail(key, "expected an array of strings, got an element of type " + type_name(e));
+    out.push_back(e.as_string()->get());
+  }
+  return out;
+}
+
 Vec2 TableReader::vec2(std::string_view key, std::optional<Vec2> fallback) {
   const toml::node* n = lookup(key);
   if (!n) {

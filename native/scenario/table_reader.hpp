@@ -45,6 +45,8 @@ class TableReader {
                      const std::vector<std::string>& allowed = {});
   /// A vector [x, y] of finite numbers.
   Vec2 vec2(std::string_view key, std::optional<Vec2> fallback);
+  /// An array of strings; empty when the key is absent.
+  std::vector<std::string> strings(std::string_view key);
   /// An array of [x, y] points (no further checks here).
   std::vector<Vec2> points(std::string_view key);
   /// An array of rows of `width` finite numbers each (at least one row).

@@ -39,6 +39,8 @@ enum class ContactOutput : std::uint8_t { all, collisions, none };
 struct OutputSettings {
   ContactOutput contacts = ContactOutput::all;  ///< which contact impulses are recorded
   int tow_every = 0;  ///< steps between rows of /tow (0: run.output_every, with the frames)
+  std::vector<std::size_t> load_bodies;  ///< bodies whose contact load goes to /loads
+  int load_every = 0;  ///< steps between rows of /loads (0: run.output_every)
 };
 
 /// Drag and radiation coefficients (MODEL.md section 2; Bigg et al. 1997 for icebergs).

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "contacts/contact_loads.hpp"
+
 namespace floedem {
 
 RopeState rope_state(const TowSpec& tow, const BodyStates& s, double t) {
@@ -35,14 +37,7 @@ void TowMonitor::before_step(const BodyStates& state, double time) {
 
 void TowMonitor::after_step(std::span<const ContactRecord> contacts, const std::array<double, 3>& env) {
   const double dt = scene_.run.dt;
-  const std::int32_t body = static_cast<std::int32_t>(tow_.body);
-  Vec2 contact;  // N s, the step's contact impulses on the towed body (the normal points from a to b)
-  for (const ContactRecord& c : contacts) {
-    if (c.body_a != body && c.body_b != body) continue;
-    const Vec2 p = c.normal_impulse * c.normal + c.tangent_impulse * perp(c.normal);
-    if (c.body_b == body) contact += p;
-    if (c.body_a == body) contact -= p;
-  }
+  const Vec2 contact = contact_impulse_on(static_cast<std::int32_t>(tow_.body), contacts);  // N s
   ice_ = -(1.0 / dt) * contact;
   if (tow_.mode == TowSpec::Mode::rope) {
     force_ = rope_.tension * rope_.direction;

@@ -52,7 +52,8 @@ def plan(ctx):
                         meta=dict(may_fail=True, case="slivers 1:50", thickness=0.5, bound=2.0, unforced=False)))
         for dt, duration in c["jam"]:
             runs.append(Run(f"stress_jam_{e}_dt{dt:g}", os.path.join(d, "jam.toml"), e,
-                            [f"run.dt={dt!r}", f"run.duration={duration!r}", "run.output_every=1000000"],
+                            [f"run.dt={dt!r}", f"run.duration={duration!r}", "run.output_every=1000000",
+                             f"output.load_every={max(1, round(1.0 / dt))}"],
                             cost=duration / dt * 0.01 * {"native": 1.0, "box2d": 1.0}.get(e, 3.0),
                             meta=dict(may_fail=True, case=f"jam 95 %, dt {dt:g} s, {duration / 60:.0f} min",
                                       thickness=1.0, bound=2.0, unforced=False, dt=dt)))
@@ -87,7 +88,15 @@ class Outcome:
             self.speed = float(a["summary_max_speed"])
             self.energy_ratio = float(a["summary_max_kinetic_energy"] / a["summary_kinetic_energy_start"]) \
                 if m["unforced"] and a["summary_kinetic_energy_start"] > 0 else math.nan
-            self.wall = float(a["summary_wall_seconds"])
+            self.wall = run.seconds
+            self.load = None
+            if "loads" in f:
+                # The ice load on the first listed body (the grounded iceberg) over the run's second
+                # half: its mean and its scatter (jitter) about the mean, 1 s means.
+                t = f["loads/time"][:]
+                fx = f["loads/force"][:, 0, 0]
+                late = t >= 0.5 * t[-1]
+                self.load = (float(np.mean(fx[late])), float(np.std(fx[late])))
         limit = PENETRATION_FRACTION * m["thickness"]
         if self.penetration > limit:
             self.reasons.append(f"penetration {self.penetration * 1e3:.3g} mm > {limit * 1e3:.3g} mm")
@@ -144,6 +153,18 @@ def write(ctx):
             "sweep passes on only about a floe's worth of momentum, so at mass ratios far above the iterations' "
             "reach the iceberg pushes through before the impulses converge. A direct (pivoting) solve of such "
             "islands or shock propagation would hold it; issue 9 stays open for it."), ""]
+    jam = [o for o in outs if not o.failed and getattr(o, "load", None) is not None]
+    if jam:
+        md += ["Ice load on the grounded iceberg in the jam (`/loads`, 1 s means over the run's second half): a design "
+               "load, and its scatter, the contact-force jitter of a resting pack. The engines' means differ where "
+               "their packs creep differently (penetration above).", "",
+               "| case | engine | mean load along the wind (kN) | std of the 1 s means (kN) | std / mean |",
+               "|---|---|---|---|---|"]
+        for o in jam:
+            mean, std = o.load
+            md.append(f"| {o.case} | {o.engine} | {mean / 1e3:.1f} | {std / 1e3:.1f} | "
+                      f"{std / abs(mean) if mean else float('nan'):.3f} |")
+        md.append("")
     runs_named = sorted({os.path.relpath(o.run.out, ctx.out) for o in outs})
     md += ["Files: " + ", ".join(f"`{x}`" for x in runs_named[:6]) + f" ... ({len(runs_named)} in `runs/stress_*`).", ""]
 

@@ -5,7 +5,7 @@ momentum-flux estimate, the restitution sensitivity, and free drift in ice again
 The statistics are over the stationary part of a run: from the moment the iceberg has
 travelled S_STAT metres (the ice pushed ahead of it has built up; the mean over later windows
 stays within the block scatter) to the end, on the 1 s means that /tow records. Their standard
-errors are from 60 s block means (the force is correlated over a few seconds, the blocks are
+errors are from 30 s block means (the force is correlated over a few seconds, the blocks are
 not)."""
 import math
 import os
@@ -19,17 +19,21 @@ SCENARIO = "towing_paper.toml"
 OPEN_WATER = "towing_open_water.toml"
 RAMP = 60.0          # s, the scenario's ramp to the towing speed
 SPEED = 0.7          # m/s
-BLOCK = 60.0         # s, blocks for the standard error of a mean
+BLOCK = 30.0         # s, blocks for the standard error of a mean (the 1 s means decorrelate in a few s)
 LIGHT = ["run.output_every=1000"]   # sweeps: a frame of every floe each 100 s is enough
 
 # Cross-check: the mean ice force of each engine against native's. The runs follow different
 # trajectories after the first collisions (broken ice is chaotic), so only statistics can agree:
 # within 4 standard errors of the difference of the means, and never closer than 10 % is asked
 # (the engines' contact geometry differs: Box2D's speculative margin and linear slop, Bullet's
-# 1 cm margin push floes aside at slightly different distances).
+# 1 cm margin push floes aside at slightly different distances). --quick averages over 250 s of
+# a narrow field, where one engine's mean carries about 8 % standard error (measured) and the
+# block estimate of it is itself rough (8 blocks): 25 %, about 3 standard errors of a difference.
 TOL_ENGINE_REL = 0.10
+TOL_ENGINE_REL_QUICK = 0.25
 TOL_ENGINE_SE = 4.0
-# The domain check: a 1.6 times wider field, mean ice force within 5 % or 3 standard errors.
+# The domain check (the full case only: --quick's field is narrow on purpose): a 1.6 times wider
+# field, mean ice force within 5 % or 3 standard errors.
 TOL_DOMAIN_REL = 0.05
 TOL_DOMAIN_SE = 3.0
 
@@ -144,8 +148,8 @@ class Case:
         self.force_stats = stats(self.force[self.keep])
         self.ice_stats = stats(self.ice[self.keep])
         self.ice_se = block_se(self.t[self.keep], self.ice[self.keep])
+        self.wall = run.seconds   # the run's wall time as the report measured it (process start to end)
         with h5py.File(run.out, "r") as f:
-            self.wall = float(f.attrs.get("summary_wall_seconds", float("nan")))
             self.steps = int(f.attrs["summary_steps"])
             ev = f["contacts/collisions"]
             time = ev["time"][:]
@@ -212,15 +216,16 @@ def write(ctx):
     md += ["", "Full towing force (kN) per engine over the same part: "
            + "; ".join(f"{e} std {kn(cs.force_stats['std'])}, peak {kn(cs.force_stats['peak'])}, p99 "
                        f"{kn(cs.force_stats['p99'])}" for cs, e in zip(engines, ctx.engines)) + ".", ""]
+    tol_rel = TOL_ENGINE_REL_QUICK if ctx.quick else TOL_ENGINE_REL
     md += [f"Agreement (cross-check): each engine's mean ice force against native's, within "
-           f"max({TOL_ENGINE_REL:.0%}, {TOL_ENGINE_SE:g} standard errors of the difference). Broken ice is chaotic: the "
+           f"max({tol_rel:.0%}, {TOL_ENGINE_SE:g} standard errors of the difference). Broken ice is chaotic: the "
            "engines' floes part ways after the first collisions, so only the statistics can agree.", "",
            "| engine | mean ice force / native's | difference / its standard error |", "|---|---|---|"]
     for case, e in zip(engines[1:], ctx.engines[1:]):
         d = case.ice_stats["mean"] - base.ice_stats["mean"]
         se = math.hypot(case.ice_se, base.ice_se)
         md.append(f"| {e} | {case.ice_stats['mean'] / base.ice_stats['mean']:.3f} | {d / se:+.2f} |")
-        allowed = max(TOL_ENGINE_REL * abs(base.ice_stats["mean"]), TOL_ENGINE_SE * se)
+        allowed = max(tol_rel * abs(base.ice_stats["mean"]), TOL_ENGINE_SE * se)
         if abs(d) > allowed:
             fails.append(f"towing: mean ice force on {e} {kn(case.ice_stats['mean'])} kN against native's "
                          f"{kn(base.ice_stats['mean'])} kN: {abs(d) / 1e3:.1f} kN apart, allowed {allowed / 1e3:.1f} kN "
@@ -269,8 +274,9 @@ def write(ctx):
            f"The same case on a field 1.6 times as wide ({', '.join(c['wide'])}): mean ice force "
            f"{kn(wide.ice_stats['mean'])} +- {kn(wide.ice_se)} kN against {kn(base.ice_stats['mean'])} +- "
            f"{kn(base.ice_se)} kN, a difference of {d / base.ice_stats['mean']:+.1%} ({d / se:+.2f} standard errors; "
-           f"`{wide.file}`). Tolerance: {TOL_DOMAIN_REL:.0%} or {TOL_DOMAIN_SE:g} standard errors.", ""]
-    if abs(d) > max(TOL_DOMAIN_REL * abs(base.ice_stats["mean"]), TOL_DOMAIN_SE * se):
+           f"`{wide.file}`). Tolerance: {TOL_DOMAIN_REL:.0%} or {TOL_DOMAIN_SE:g} standard errors"
+           + (" (not checked with --quick, whose field is narrow on purpose)." if ctx.quick else "."), ""]
+    if not ctx.quick and abs(d) > max(TOL_DOMAIN_REL * abs(base.ice_stats["mean"]), TOL_DOMAIN_SE * se):
         fails.append(f"towing: the wider domain changes the mean ice force by {d / base.ice_stats['mean']:+.1%} "
                      f"({d / se:+.2f} s.e.; {wide.file})")
 

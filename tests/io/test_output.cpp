@@ -152,3 +152,34 @@ TEST_CASE("an unwritable output directory is an output error, and nothing is lef
   CHECK_THROWS_AS(run_scene(s, o), OutputError);
   CHECK_FALSE(fs::exists("/nonexistent-dir/r.h5.partial"));
 }
+
+TEST_CASE("/loads: a floe pressed on a wall by the current loads it with the floe's drag", "[output][loads]") {
+  // A 10 m square floe, 1 m thick, at rest against a fixed wall, a 0.5 m/s current towards the
+  // wall: in equilibrium the wall carries the water drag on the floe at rest,
+  // 1/2 rho_w C_w W d u^2 + rho_w C_dw A u^2 with draft d = h rho_i / rho_w (MODEL.md 2).
+  const std::string text =
+      "[run]\nduration = 60.0\ndt = 0.1\noutput_every = 600\n[output]\ncontacts = \"none\"\nloads = [\"wall\"]\n"
+      "load_every = 10\n[environment]\ncurrent = [-0.5, 0.0]\n"
+      "[[body]]\nname = \"wall\"\npolygon = [[-5,-20],[0,-20],[0,20],[-5,20]]\nthickness = 5.0\nfixed = true\n"
+      "[[body]]\nname = \"floe\"\npolygon = [[0,-5],[10,-5],[10,5],[0,5]]\nthickness = 1.0\n";
+  const Scene s = test::scene_from(text);
+  const fs::path out = fs::temp_directory_path() / ("floedem-loads-" + std::to_string(::getpid()) + ".h5");
+  RunOptions o;
+  o.output = out.string();
+  o.progress = false;
+  run_scene(s, o);
+  H5::H5File f(out.string(), H5F_ACC_RDONLY);
+  H5::DataSet force = f.openDataSet("/loads/force");
+  hsize_t dims[3];
+  REQUIRE(force.getSpace().getSimpleExtentNdims() == 3);
+  force.getSpace().getSimpleExtentDims(dims);
+  CHECK(dims[0] == 60);  // every 10 steps of 600
+  CHECK(dims[1] == 1);
+  std::vector<double> v(dims[0] * 2);
+  force.read(v.data(), H5::PredType::NATIVE_DOUBLE);
+  const double draft = 1.0 * 900.0 / 1025.0;
+  const double drag = 0.5 * 1025.0 * 0.9 * 10.0 * draft * 0.25 + 1025.0 * 5e-4 * 100.0 * 0.25;
+  CHECK(v[2 * (dims[0] - 1)] == Approx(-drag).epsilon(1e-6));  // the floe pushes the wall along -x
+  CHECK(v[2 * (dims[0] - 1) + 1] == Approx(0.0).margin(1e-6 * drag));
+  fs::remove(out);
+}
