@@ -116,7 +116,7 @@ def main():
             "`runs/` (each table names its files); none is typed or kept from an earlier report.", "",
             "## Cross-check", ""]
     if fails:
-        head += [f"**{len(fails)} disagreements beyond the documented tolerances:**", ""] + [f"- {x}" for x in fails]
+        head += [f"**{len(fails)} disagreement{'s' if len(fails) > 1 else ''} beyond the documented tolerances:**", ""] + [f"- {x}" for x in fails]
     else:
         head += ["Every engine agrees with native, and native with the closed forms, within the tolerances stated "
                  "in each section."]

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing, builds, and runs every test with ctest.
 #   scripts/test.sh              Release build in ./build, then the cross-engine check
-#                                (`floedem report --quick`, about 2 minutes on 2 cores)
+#                                (`floedem report --quick`, 3 to 4 minutes on 2 cores)
 #   scripts/test.sh --sanitize   the same suite built with AddressSanitizer and
 #                                UndefinedBehaviorSanitizer in ./build-sanitize; any report fails
 set -euo pipefail

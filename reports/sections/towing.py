@@ -343,6 +343,7 @@ def write(ctx):
         md.append(f"| {e:g} | {kn(k.ice_stats['mean'])} | {kn(k.ice_se)} | {kn(k.ice_stats['peak'])} | "
                   f"{kn(k.ice_stats['p99'])} | {k.collisions} | {k.berg_collisions} | {k.berg_peak_collision / 1e6:.2f} | "
                   f"`{k.file}` |")
+    md.append("")
     es = np.array([e for e, _ in rest])
     fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
     axes[0][0].errorbar(es, [k.ice_stats["mean"] / 1e3 for _, k in rest],
