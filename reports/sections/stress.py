@@ -19,6 +19,7 @@ from report_runner import Run
 MASSES = [1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10]   # kg, iceberg: ratios 1e2..1e8 to the 99 kg floes
 FLOE_MASS = 0.11 * 900.0                         # kg, the mass_ratio floes
 PENETRATION_FRACTION = 0.01
+ITERATIONS_LADDER = 5000                         # native's velocity iterations for the second ladder
 
 
 def config(quick):
@@ -57,6 +58,13 @@ def plan(ctx):
                             cost=duration / dt * 0.01 * {"native": 1.0, "box2d": 1.0}.get(e, 3.0),
                             meta=dict(may_fail=True, case=f"jam 95 %, dt {dt:g} s, {duration / 60:.0f} min",
                                       thickness=1.0, bound=2.0, unforced=False, dt=dt)))
+    # Native with 100 times the iterations: penetration goes as ratio / iterations, so this shows
+    # how far more sweeps carry the heavy-light chain (the tolerance stop keeps most steps short).
+    for m in c["masses"][1:]:
+        runs.append(Run(f"stress_mass_native_it5000_{m:.0e}", os.path.join(d, "mass_ratio.toml"), "native",
+                        [f"body[0].mass={m!r}", f"engine.native.velocity_iterations={ITERATIONS_LADDER}"], cost=2.0,
+                        meta=dict(may_fail=True, case=f"mass ratio (native, {ITERATIONS_LADDER} iterations)",
+                                  ratio=m / FLOE_MASS, thickness=0.11, bound=2 * 0.2, unforced=True)))
     if c["jam_long"]:
         dt, duration = c["jam_long"]
         runs.append(Run("stress_jam_native_6h", os.path.join(d, "jam.toml"), "native",
@@ -132,7 +140,7 @@ def write(ctx):
         sel = [o for o in outs if o.case == case]
         keys = sorted({o.run.meta.get("ratio") for o in sel if o.run.meta.get("ratio") is not None}) or [None]
         for key in keys:
-            label = case + (f" {key:.0e}" if key is not None and case == "mass ratio" else "")
+            label = case.replace("mass ratio", f"mass ratio {key:.0e}", 1) if key is not None else case
             cells = []
             for e in ctx.engines:
                 o = next((x for x in sel if x.engine == e and x.run.meta.get("ratio") == key), None)
@@ -147,12 +155,13 @@ def write(ctx):
     broken = [o for o in native if not o.holds]
     md += ["", f"Native holds in {len(native) - len(broken)} of {len(native)} runs." +
            ("" if not broken else " Where it does not: " + "; ".join(
-               f"{o.case}{' ' + format(o.run.meta['ratio'], '.0e') if o.case == 'mass ratio' else ''} "
+               f"{o.case.replace('mass ratio', 'mass ratio ' + format(o.run.meta['ratio'], '.0e'), 1) if 'ratio' in o.run.meta else o.case} "
                f"({', '.join(o.reasons)})" for o in broken) +
             ". A heavy body pressing light floes against a wall is the known limit of projected Gauss-Seidel: each "
-            "sweep passes on only about a floe's worth of momentum, so at mass ratios far above the iterations' "
-            "reach the iceberg pushes through before the impulses converge. A direct (pivoting) solve of such "
-            "islands or shock propagation would hold it; issue 9 stays open for it."), ""]
+            "sweep passes on only about a floe's worth of momentum, so the penetration goes as the mass ratio over "
+            f"the iterations (the {ITERATIONS_LADDER}-iteration rows); far above the iterations' reach the iceberg "
+            "pushes through before the impulses converge. A direct (pivoting) solve of such islands or shock "
+            "propagation would hold it; issue 9 stays open for it."), ""]
     jam = [o for o in outs if not o.failed and getattr(o, "load", None) is not None]
     if jam:
         md += ["Ice load on the grounded iceberg in the jam (`/loads`, 1 s means over the run's second half): a design "
@@ -173,7 +182,13 @@ def write(ctx):
         sel = sorted([o for o in outs if o.engine == e and o.case == "mass ratio" and not o.failed],
                      key=lambda o: o.run.meta["ratio"])
         if sel:
-            axes[0].loglog([o.run.meta["ratio"] for o in sel], [o.penetration / 0.11 for o in sel], "o-", label=e)
+            line, = axes[0].loglog([o.run.meta["ratio"] for o in sel], [o.penetration / 0.11 for o in sel], "o-",
+                                   label=e)
+            more = sorted([o for o in outs if o.engine == e and o.case.startswith("mass ratio (native,")
+                           and not o.failed], key=lambda o: o.run.meta["ratio"])
+            if more:
+                axes[0].loglog([o.run.meta["ratio"] for o in more], [o.penetration / 0.11 for o in more], "o--",
+                               color=line.get_color(), mfc="none", label=f"{e}, {ITERATIONS_LADDER} iterations")
         jam = sorted([o for o in outs if o.engine == e and "dt" in o.run.meta and not o.failed and "6 h" not in o.case],
                      key=lambda o: o.run.meta["dt"])
         if jam:
