@@ -1,8 +1,9 @@
 """Numerical stability under stress (issue 9): scenarios/stress/ on every engine, and the
 stability map. A run "holds" when it finishes (no NaN or infinity: floedem exits 4 on one),
 its deepest penetration stays below 1 % of the thinnest floe's thickness, no body moves faster
-than the case allows, and, without forcing, the kinetic energy never rises above its start
-(summary attributes of each run: max_penetration, max_speed, max_kinetic_energy).
+than the case allows, no body ends up beyond a wall (tunnelling), and, without forcing, the
+kinetic energy never rises above its start (summary attributes of each run: max_penetration,
+max_speed, max_kinetic_energy; the last frame for the walls).
 
 Why these bounds: 1 % of the thickness is the issue's bound (a floe 0.11 m thick may overlap
 its neighbour by 1.1 mm); the speed bounds are what momentum allows (a floe struck by a body of
@@ -20,6 +21,12 @@ MASSES = [1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10]   # kg, iceberg: ratios 1e2..1e8 t
 FLOE_MASS = 0.11 * 900.0                         # kg, the mass_ratio floes
 PENETRATION_FRACTION = 0.01
 ITERATIONS_LADDER = 5000                         # native's velocity iterations for the second ladder
+# Where the moving bodies must stay (x_min, x_max, y_min, y_max; m): in front of the wall whose
+# face is x = 0 (mass_ratio, slivers), inside the walled bay (jam). A centroid beyond is a body
+# pushed through a wall: tunnelling.
+INF = math.inf
+WALL_AT_X0 = (0.0, INF, -INF, INF)
+BAY = (-INF, 200.0, -100.0, 100.0)
 
 
 def config(quick):
@@ -36,11 +43,11 @@ def plan(ctx):
         for m in c["masses"]:
             runs.append(Run(f"stress_mass_{e}_{m:.0e}", os.path.join(d, "mass_ratio.toml"), e, [f"body[0].mass={m!r}"],
                             cost=0.5, meta=dict(may_fail=True, case="mass ratio", ratio=m / FLOE_MASS, thickness=0.11,
-                                                bound=2 * 0.2, unforced=True)))
+                                                bound=2 * 0.2, unforced=True, inside=WALL_AT_X0)))
         runs.append(Run(f"stress_fast_{e}", os.path.join(d, "mass_ratio.toml"), e,
                         ["body[0].mass=1e6", "body[0].velocity=[-5.0, 0.0]", "run.duration=4.0", "run.dt=0.01"],
                         cost=0.5, meta=dict(may_fail=True, case="fast impact, 5 m/s", ratio=1e6 / FLOE_MASS,
-                                            thickness=0.11, bound=2 * 5.0, unforced=True)))
+                                            thickness=0.11, bound=2 * 5.0, unforced=True, inside=WALL_AT_X0)))
         runs.append(Run(f"stress_fast_floes_{e}", os.path.join(ctx.scenarios, "impacts", "floe_floe_headon.toml"), e,
                         ["body[0].velocity=[2.5, 0.0]", "body[1].velocity=[-2.5, 0.0]", "run.dt=0.01",
                          "run.duration=2.0"],
@@ -50,27 +57,29 @@ def plan(ctx):
                         meta=dict(may_fail=True, case="8 simultaneous contacts", thickness=1.0, bound=2 * 0.5,
                                   unforced=True)))
         runs.append(Run(f"stress_slivers_{e}", os.path.join(d, "slivers.toml"), e, [], cost=1.0,
-                        meta=dict(may_fail=True, case="slivers 1:50", thickness=0.5, bound=2.0, unforced=False)))
+                        meta=dict(may_fail=True, case="slivers 1:50", thickness=0.5, bound=2.0, unforced=False,
+                                  inside=WALL_AT_X0)))
         for dt, duration in c["jam"]:
             runs.append(Run(f"stress_jam_{e}_dt{dt:g}", os.path.join(d, "jam.toml"), e,
                             [f"run.dt={dt!r}", f"run.duration={duration!r}", "run.output_every=1000000",
                              f"output.load_every={max(1, round(1.0 / dt))}"],
                             cost=duration / dt * 0.01 * {"native": 1.0, "box2d": 1.0}.get(e, 3.0),
                             meta=dict(may_fail=True, case=f"jam 95 %, dt {dt:g} s, {duration / 60:.0f} min",
-                                      thickness=1.0, bound=2.0, unforced=False, dt=dt)))
+                                      thickness=1.0, bound=2.0, unforced=False, dt=dt, inside=BAY)))
     # Native with 100 times the iterations: penetration goes as ratio / iterations, so this shows
     # how far more sweeps carry the heavy-light chain (the tolerance stop keeps most steps short).
     for m in c["masses"][1:]:
         runs.append(Run(f"stress_mass_native_it5000_{m:.0e}", os.path.join(d, "mass_ratio.toml"), "native",
                         [f"body[0].mass={m!r}", f"engine.native.velocity_iterations={ITERATIONS_LADDER}"], cost=2.0,
                         meta=dict(may_fail=True, case=f"mass ratio (native, {ITERATIONS_LADDER} iterations)",
-                                  ratio=m / FLOE_MASS, thickness=0.11, bound=2 * 0.2, unforced=True)))
+                                  ratio=m / FLOE_MASS, thickness=0.11, bound=2 * 0.2, unforced=True,
+                                  inside=WALL_AT_X0)))
     if c["jam_long"]:
         dt, duration = c["jam_long"]
         runs.append(Run("stress_jam_native_6h", os.path.join(d, "jam.toml"), "native",
                         [f"run.dt={dt!r}", f"run.duration={duration!r}"], cost=duration / dt * 0.01,
                         meta=dict(may_fail=True, case="jam 95 %, dt 0.5 s, 6 h", thickness=1.0, bound=2.0,
-                                  unforced=False, dt=dt)))
+                                  unforced=False, dt=dt, inside=BAY)))
     runs.append(Run("stress_drift_24h", os.path.join(ctx.scenarios, "free_drift.toml"), "native",
                     ["run.duration=86400.0"], cost=0.5,
                     meta=dict(may_fail=True, case="free drift, 24 h", thickness=80.0, bound=2.0, unforced=False)))
@@ -97,6 +106,13 @@ class Outcome:
             self.energy_ratio = float(a["summary_max_kinetic_energy"] / a["summary_kinetic_energy_start"]) \
                 if m["unforced"] and a["summary_kinetic_energy_start"] > 0 else math.nan
             self.wall = run.seconds
+            self.escaped = 0
+            if "inside" in m:
+                x0, x1, y0, y1 = m["inside"]
+                moving = ~f["bodies/fixed"][:].astype(bool)
+                p = f["bodies/position"][-1]
+                out = (p[:, 0] < x0) | (p[:, 0] > x1) | (p[:, 1] < y0) | (p[:, 1] > y1)
+                self.escaped = int(np.count_nonzero(out & moving))
             self.load = None
             if "loads" in f:
                 # The ice load on the first listed body (the grounded iceberg) over the run's second
@@ -110,6 +126,8 @@ class Outcome:
             self.reasons.append(f"penetration {self.penetration * 1e3:.3g} mm > {limit * 1e3:.3g} mm")
         if self.speed > m["bound"]:
             self.reasons.append(f"speed {self.speed:.3g} m/s > {m['bound']:.3g}")
+        if self.escaped:
+            self.reasons.append(f"{self.escaped} bodies through a wall")
         if m["unforced"] and self.energy_ratio > 1.0 + 1e-6:
             self.reasons.append(f"energy gain x{self.energy_ratio:.6g}")
 
@@ -131,7 +149,8 @@ def write(ctx):
     md = ["## Stability under stress", "",
           "`scenarios/stress/` on every engine (issue 9). A run holds when it finishes without a non-finite state, its "
           f"deepest penetration stays below {PENETRATION_FRACTION:.0%} of the thinnest floe's thickness, no body moves "
-          "faster than momentum allows (2 V for a body struck at V; 2 m/s under wind and current), and without "
+          "faster than momentum allows (2 V for a body struck at V; 2 m/s under wind and current), none is pushed "
+          "through a wall (its centroid beyond the wall's face at the end), and without "
           "forcing the kinetic energy never exceeds its start (figures from each run's `summary_*` attributes). "
           "Cells: yes (with the deepest penetration), or no and why.", "",
           "![stability map](fig/stability_map.png)", "",
