@@ -325,9 +325,9 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     if (!scene.output.load_bodies.empty()) {
       H5::Group loads = d.file.createGroup("/loads");
       const hsize_t nb = scene.output.load_bodies.size();
-      std::vector<std::int32_t> which;
-      for (const std::size_t i : scene.output.load_bodies) which.push_back(static_cast<std::int32_t>(i));
-      write_fixed(loads, "body", H5::PredType::NATIVE_INT32, which, {nb});
+      std::vector<std::int32_t> load_ids;
+      for (const std::size_t i : scene.output.load_bodies) load_ids.push_back(static_cast<std::int32_t>(i));
+      write_fixed(loads, "body", H5::PredType::NATIVE_INT32, load_ids, {nb});
       d.load_time = Series(loads, "time", H5::PredType::NATIVE_DOUBLE, {}, 1024);
       d.load_force = Series(loads, "force", H5::PredType::NATIVE_DOUBLE, {nb, 2}, 1024);
     }
@@ -347,13 +347,16 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
 
 void Recorder::check_space(const Scene& scene) const {
   // The frames' size is known before the run: 6 doubles per body and frame (position, angle,
-  // velocity, angular velocity), plus /tow's 9 per row. A disk too small for them is told now,
-  // not hours into the run (contact rows depend on the run and are not counted).
+  // velocity, angular velocity), plus /tow's 9 per row and /loads' 1 + 2 per body per row. A
+  // disk too small for them is told now, not hours into the run (contact rows depend on the run
+  // and are not counted).
   const double steps = static_cast<double>(scene.run.steps());
   const double frames = steps / scene.run.output_every + 2.0;
-  const int tow_every = scene.output.tow_every > 0 ? scene.output.tow_every : scene.run.output_every;
-  const double tow_rows = scene.tow.mode == TowSpec::Mode::none ? 0.0 : steps / tow_every + 2.0;
-  const double bytes = 8.0 * (frames * (6.0 * static_cast<double>(scene.bodies.size()) + 1.0) + 9.0 * tow_rows);
+  const double tow_rows = scene.tow.mode == TowSpec::Mode::none ? 0.0 : steps / scene.tow_every() + 2.0;
+  const double load_rows = scene.output.load_bodies.empty() ? 0.0 : steps / scene.load_every() + 2.0;
+  const double bytes =
+      8.0 * (frames * (6.0 * static_cast<double>(scene.bodies.size()) + 1.0) + 9.0 * tow_rows +
+             load_rows * (1.0 + 2.0 * static_cast<double>(scene.output.load_bodies.size())));
   const std::filesystem::path dir = std::filesystem::absolute(path_).parent_path();
   struct statvfs fs {};
   if (statvfs(dir.c_str(), &fs) != 0) return;  // a missing directory is reported on creation

@@ -79,9 +79,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const std::int64_t steps = scene.run.steps();
   summary.kinetic_energy_start = kinetic_energy(scene, stepper.state());
   TowMonitor& tow = stepper.tow();
-  const std::int64_t tow_every = scene.output.tow_every > 0 ? scene.output.tow_every : scene.run.output_every;
   ContactLoads loads(scene);
-  const std::int64_t load_every = scene.output.load_every > 0 ? scene.output.load_every : scene.run.output_every;
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   if (tow.active()) recorder.write_tow(0.0, {{nan, nan}, {nan, nan}, {nan, nan}, tow.tug_position(0.0)});  // no step yet
   recorder.write_frame(0.0, stepper.state());
@@ -122,10 +120,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     recorder.write_contacts(t_end, contacts);
     collisions.observe(t_end, contacts, state, ended);
     if (!ended.empty()) record_collisions();
-    if (tow.active() && (k % tow_every == 0 || k == steps)) recorder.write_tow(t_end, tow.take_frame(t_end));
+    if (tow.active() && (k % scene.tow_every() == 0 || k == steps)) recorder.write_tow(t_end, tow.take_frame(t_end));
     if (loads.active()) {
       loads.after_step(contacts);
-      if (k % load_every == 0 || k == steps) recorder.write_loads(t_end, loads.take_row());
+      if (k % scene.load_every() == 0 || k == steps) recorder.write_loads(t_end, loads.take_row());
     }
     if (k % scene.run.output_every == 0 || k == steps) recorder.write_frame(t_end, state);
     progress.update(k, steps);

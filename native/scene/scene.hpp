@@ -177,6 +177,9 @@ struct Scene {
   /// Mass the engines move: m, plus the added mass when it enters contacts too.
   double engine_mass(std::size_t body) const;
   double engine_inertia(std::size_t body) const;
+  /// Steps between rows of /tow and of /loads: the [output] setting, or with the frames.
+  int tow_every() const { return output.tow_every > 0 ? output.tow_every : run.output_every; }
+  int load_every() const { return output.load_every > 0 ? output.load_every : run.output_every; }
   /// 1 / engine_mass and 1 / engine_inertia, 0 for a fixed or prescribed body (infinite mass
   /// in contacts).
   double engine_inverse_mass(std::size_t body) const;

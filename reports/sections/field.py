@@ -6,7 +6,7 @@ import h5py
 import numpy as np
 
 import plot_field
-from floedem_h5 import equal_area_diameters, truncated_power_law_survival  # noqa: F401
+from floedem_h5 import equal_area_diameters
 
 
 def mle_alpha(d, d_min, d_max):

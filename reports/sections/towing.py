@@ -101,12 +101,11 @@ def plan(ctx):
 # Reading
 
 
-def tow_series(path):
-    """/tow: time, towing force along x (N), its ice part along x (N), path position x (m)."""
-    with h5py.File(path, "r") as f:
-        g = f["tow"]
-        t = g["time"][:]
-        return t, g["force_mean"][:, 0], g["ice_force_mean"][:, 0], g["tug_position"][:, 0]
+def tow_series(f):
+    """/tow of an open run file: time, towing force along x (N), its ice part along x (N), path
+    position x (m)."""
+    g = f["tow"]
+    return g["time"][:], g["force_mean"][:, 0], g["ice_force_mean"][:, 0], g["tug_position"][:, 0]
 
 
 def window(t, tug_x, s_stat):
@@ -142,14 +141,14 @@ class Case:
     def __init__(self, run, s_stat, rel_to):
         self.run = run
         self.file = os.path.relpath(run.out, rel_to)
-        self.t, self.force, self.ice, self.x = tow_series(run.out)
-        self.keep = window(self.t, self.x, s_stat)
-        self.t_stat = float(self.t[self.keep][0])
-        self.force_stats = stats(self.force[self.keep])
-        self.ice_stats = stats(self.ice[self.keep])
-        self.ice_se = block_se(self.t[self.keep], self.ice[self.keep])
         self.wall = run.seconds   # the run's wall time as the report measured it (process start to end)
         with h5py.File(run.out, "r") as f:
+            self.t, self.force, self.ice, self.x = tow_series(f)
+            self.keep = window(self.t, self.x, s_stat)
+            self.t_stat = float(self.t[self.keep][0])
+            self.force_stats = stats(self.force[self.keep])
+            self.ice_stats = stats(self.ice[self.keep])
+            self.ice_se = block_se(self.t[self.keep], self.ice[self.keep])
             self.steps = int(f.attrs["summary_steps"])
             ev = f["contacts/collisions"]
             time = ev["time"][:]
@@ -195,7 +194,8 @@ def write(ctx):
     md = ["## Towing forces: the paper's case", ""]
     engines = [Case(ctx.run(f"towing_{e}"), c["s_stat"], rel) for e in ctx.engines]
     base = engines[0]
-    ow = tow_series(ctx.run("towing_open_water").out)
+    with h5py.File(ctx.run("towing_open_water").out, "r") as f:
+        ow = tow_series(f)
     ow_keep = window(ow[0], ow[3], c["s_stat"])
     drag = float(np.mean(ow[1][ow_keep]))
     md += [f"`scenarios/{SCENARIO}`{' (smaller for --quick: ' + ', '.join(c['sets']) + ')' if c['sets'] else ''}: "
