@@ -32,7 +32,7 @@ std::vector<AreaPoint> area_points(const std::vector<Vec2>& poly) {
   return out;
 }
 
-void add_form_drag(ForceSums& sums, std::size_t body, const std::vector<EdgePoint>& edges, double scale, double c,
+void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double scale, double c,
                    Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& s) {
   for (const EdgePoint& e : edges) {
     const Vec2 r = rot.apply(scale * e.r);
@@ -53,11 +53,11 @@ void add_form_drag(ForceSums& sums, std::size_t body, const std::vector<EdgePoin
       f = (-k * un) * u;
       a = {k * (-un - u.x * n.x), -k * u.x * n.y, -k * u.y * n.x, k * (-un - u.y * n.y)};
     }
-    sums.add_point_force(body, r, f, a, s.rotational);
+    sum.add_point_force(r, f, a, s.rotational);
   }
 }
 
-void add_skin_drag(ForceSums& sums, std::size_t body, const std::vector<AreaPoint>& points, double scale, double c,
+void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double scale, double c,
                    Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& s) {
   for (const AreaPoint& p : points) {
     const Vec2 r = rot.apply(scale * p.r);
@@ -75,7 +75,7 @@ void add_skin_drag(ForceSums& sums, std::size_t body, const std::vector<AreaPoin
       const double inv = m > 0.0 ? 1.0 / m : 0.0;
       a = {k * (m + u.x * u.x * inv), k * u.x * u.y * inv, k * u.x * u.y * inv, k * (m + u.y * u.y * inv)};
     }
-    sums.add_point_force(body, r, f, a, s.rotational);
+    sum.add_point_force(r, f, a, s.rotational);
   }
 }
 
@@ -91,17 +91,32 @@ void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_
   entries_.push_back(std::move(e));
 }
 
+bool DistributedDrag::adds_nothing(const Entry& e, Vec2 v, double w) const {
+  // A body moving with the flow of every slab, without spin, feels no quadratic drag: u = 0 at
+  // every quadrature point, so each point adds exactly zero force and Jacobian (a form-drag
+  // point is skipped at u.n = 0; a skin point adds k |u| u = 0). Skipping it is exact, so a
+  // field of floes at rest in calm water costs nothing here. Linearised skin drag keeps its
+  // Jacobian k U_ref I at u = 0, so it is never skipped.
+  if (w != 0.0 || (kind_ == Kind::skin && settings_.reference_speed > 0.0)) return false;
+  for (const DragSlab& slab : e.slabs)
+    if (slab.flow.x != v.x || slab.flow.y != v.y) return false;
+  return true;
+}
+
 void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
   for (const Entry& e : entries_) {
+    const Vec2 v = s.velocity[e.body];
+    const double w = s.angular_velocity[e.body];
+    if (adds_nothing(e, v, w)) continue;
     const Rot rot = Rot::from_angle(s.angle[e.body]);
+    BodySum sum = sums.load(e.body);
     for (const DragSlab& slab : e.slabs) {
       if (kind_ == Kind::form)
-        add_form_drag(sums, e.body, e.edges, slab.scale, slab.c, slab.flow, s.velocity[e.body], s.angular_velocity[e.body],
-                      rot, settings_);
+        add_form_drag(sum, e.edges, slab.scale, slab.c, slab.flow, v, w, rot, settings_);
       else
-        add_skin_drag(sums, e.body, e.points, slab.scale, slab.c, slab.flow, s.velocity[e.body], s.angular_velocity[e.body],
-                      rot, settings_);
+        add_skin_drag(sum, e.points, slab.scale, slab.c, slab.flow, v, w, rot, settings_);
     }
+    sums.store(e.body, sum);
   }
 }
 

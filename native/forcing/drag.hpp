@@ -37,11 +37,11 @@ struct DragSettings {
 
 /// Adds form drag of a slab (height h, outline scaled by s) in the flow V: coefficient
 /// c = 1/2 rho C h.
-void add_form_drag(ForceSums& sums, std::size_t body, const std::vector<EdgePoint>& edges, double scale, double c,
+void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double scale, double c,
                    Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings);
 
 /// Adds skin drag over an area (outline scaled by s): coefficient c = rho C.
-void add_skin_drag(ForceSums& sums, std::size_t body, const std::vector<AreaPoint>& points, double scale, double c,
+void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double scale, double c,
                    Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings);
 
 /// One layer of a body that feels a drag: its coefficient (1/2 rho C h for form drag, rho C
@@ -70,6 +70,8 @@ class DistributedDrag final : public ForceTerm {
     std::vector<AreaPoint> points;  // skin drag
     std::vector<DragSlab> slabs;
   };
+  bool adds_nothing(const Entry& e, Vec2 v, double w) const;
+
   std::string_view name_;
   Kind kind_;
   DragSettings settings_;

@@ -16,6 +16,37 @@
 
 namespace floedem {
 
+/// One body's generalised force Q and Jacobian dQ/dq while a term adds to it point by point:
+/// a copy held in registers (the per-point sums would otherwise go through memory, since the
+/// compiler cannot rule out aliasing with the quadrature data), added in the same order as
+/// point by point into ForceSums, so the result is the same to the bit.
+struct BodySum {
+  std::array<double, 3> q;
+  std::array<double, 9> d;
+  /// Adds the force f acting at offset r (world) from the centroid, with dF/du = a (2x2,
+  /// row-major) where u = flow - (v + w k x r): Q += G^T f, dQ/dq -= G^T a G, G = [I, k x r].
+  void add_point_force(Vec2 r, Vec2 f, const std::array<double, 4>& a, bool with_torque) {
+    // G = [[1, 0, -r_y], [0, 1, r_x]] maps q to the point's velocity.
+    const double gx = with_torque ? -r.y : 0.0, gy = with_torque ? r.x : 0.0;
+    q[0] += f.x;
+    q[1] += f.y;
+    if (with_torque) q[2] += cross(r, f);
+    // G^T a G, with a = [[a0, a1], [a2, a3]].
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3];
+    const double c0 = a0 * gx + a1 * gy;  // (a G)_{0,2}
+    const double c1 = a2 * gx + a3 * gy;  // (a G)_{1,2}
+    d[0] -= a0;
+    d[1] -= a1;
+    d[2] -= c0;
+    d[3] -= a2;
+    d[4] -= a3;
+    d[5] -= c1;
+    d[6] -= gx * a0 + gy * a2;
+    d[7] -= gx * a1 + gy * a3;
+    d[8] -= gx * c0 + gy * c1;
+  }
+};
+
 /// Per-body sums the terms add to, in world axes about each body's centroid.
 struct ForceSums {
   std::vector<std::array<double, 3>> q;   ///< generalised force (N, N, N m)
@@ -29,9 +60,20 @@ struct ForceSums {
     q[i][1] += f.y;
     q[i][2] += torque;
   }
-  /// Adds the force f acting at offset r (world) from the centroid, with dF/du = a (2x2,
-  /// row-major) where u = flow - (v + w k x r): Q += G^T f, dQ/dq -= G^T a G, G = [I, k x r].
-  void add_point_force(std::size_t i, Vec2 r, Vec2 f, const std::array<double, 4>& a, bool with_torque);
+  BodySum load(std::size_t i) const { return {q[i], dq[i]}; }
+  /// Stores a body's sum back after a term added point forces to it (so Jacobian entries).
+  void store(std::size_t i, const BodySum& s) {
+    q[i] = s.q;
+    dq[i] = s.d;
+    any_jacobian = true;
+  }
+  /// One point force on body i (BodySum::add_point_force); terms that add many points to a
+  /// body use load / store around them instead.
+  void add_point_force(std::size_t i, Vec2 r, Vec2 f, const std::array<double, 4>& a, bool with_torque) {
+    BodySum s = load(i);
+    s.add_point_force(r, f, a, with_torque);
+    store(i, s);
+  }
 };
 
 class ForceTerm {

@@ -65,29 +65,6 @@ bool Forcing::stiff(const std::array<double, 9>& d, double mass, double inertia)
   return dt_ * std::max(linear, angular) > kExplicitLimit;
 }
 
-void ForceSums::add_point_force(std::size_t i, Vec2 r, Vec2 f, const std::array<double, 4>& a, bool with_torque) {
-  // G = [[1, 0, -r_y], [0, 1, r_x]] maps q to the point's velocity.
-  const double gx = with_torque ? -r.y : 0.0, gy = with_torque ? r.x : 0.0;
-  q[i][0] += f.x;
-  q[i][1] += f.y;
-  if (with_torque) q[i][2] += cross(r, f);
-  // G^T a G, with a = [[a0, a1], [a2, a3]].
-  const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3];
-  const double c0 = a0 * gx + a1 * gy;  // (a G)_{0,2}
-  const double c1 = a2 * gx + a3 * gy;  // (a G)_{1,2}
-  std::array<double, 9>& d = dq[i];
-  d[0] -= a0;
-  d[1] -= a1;
-  d[2] -= c0;
-  d[3] -= a2;
-  d[4] -= a3;
-  d[5] -= c1;
-  d[6] -= gx * a0 + gy * a2;
-  d[7] -= gx * a1 + gy * a3;
-  d[8] -= gx * c0 + gy * c1;
-  any_jacobian = true;
-}
-
 Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
   for (const ForceTermBuilder build : kTerms)
     if (auto term = build(scene)) terms_.push_back(std::move(term));

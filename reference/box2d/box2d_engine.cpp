@@ -11,6 +11,7 @@
 
 #include <box2d/box2d.h>
 
+#include <algorithm>
 #include <unordered_map>
 
 #include "geometry/polygon.hpp"
@@ -155,7 +156,11 @@ void Box2dEngine::PostSolve(b2Contact* contact, const b2ContactImpulse* impulse)
   const Vec2 n{wm.normal.x, wm.normal.y};  // from A to B
   const Vec2 t{n.y, -n.x};                 // Box2D's tangent: b2Cross(normal, 1)
   const auto found = approach_.find(contact);
-  for (int k = 0; k < contact->GetManifold()->pointCount; ++k) {
+  // impulse->count, not the manifold's point count: Box2D solves a two-point manifold whose
+  // block system is ill-conditioned as one point (b2ContactSolver sets pointCount = 1) and then
+  // reports one impulse; the second slot is left uninitialised (read here, it made runs differ).
+  const int count = std::min(impulse->count, contact->GetManifold()->pointCount);
+  for (int k = 0; k < count; ++k) {
     const double pn = impulse->normalImpulses[k], pt = impulse->tangentImpulses[k];
     if (pn == 0.0 && pt == 0.0) continue;
     // floedem's convention: a < b, normal from a to b, impulses on b.

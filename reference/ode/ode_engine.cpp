@@ -82,6 +82,7 @@ class OdeEngine final : public Engine {
   ContactSettings contact_;
   dWorldID world_ = nullptr;
   dJointGroupID contact_group_ = nullptr;
+  unsigned long random_seed_ = 0;  ///< QuickStep's constraint shuffle (ODE's initial seed is 0)
   std::vector<dBodyID> bodies_;  // nullptr for fixed bodies
   std::vector<Vec2> fixed_position_;
   PartSet parts_;
@@ -253,10 +254,16 @@ void OdeEngine::step(const Loads* loads) {
         dBodyAddTorque(bodies_[i], 0.0, 0.0, loads->torque[i]);
       }
   }
+  // QuickStep shuffles its constraint order with ODE's one global random generator, so a
+  // second world in the same process (a test, a sweep) would continue the first one's stream
+  // and give another result. Each engine keeps its own seed across steps instead: a run is
+  // the same wherever it is made.
+  dRandSetSeed(random_seed_);
   if (settings_.quick_step)
     dWorldQuickStep(world_, dt_);
   else
     dWorldStep(world_, dt_);
+  random_seed_ = dRandGetSeed();
   keep_in_plane();
   // Impulses: the joints' forces on body 1 times dt.
   records_.clear();
