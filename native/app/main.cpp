@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "app/bench_command.hpp"
 #include "app/field_command.hpp"
 #include "app/python_script.hpp"
 #include "engine/registry.hpp"
@@ -71,6 +72,9 @@ int main(int argc, char** argv) {
   report->add_option("--jobs,-j", report_jobs, "runs at a time (default: the number of cores)")
       ->check(CLI::PositiveNumber);
 
+  floedem::BenchCommand bench_options;
+  CLI::App* bench = floedem::add_bench_command(app, bench_options);
+
   floedem::FieldCommand field_options;
   CLI::App* field = floedem::add_field_command(app, field_options);
 
@@ -87,6 +91,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (field->parsed()) return floedem::run_field_command(field_options);
+    if (bench->parsed()) return floedem::run_bench_command(bench_options);
     if (report->parsed()) {
       // Exit status as the script's: 0 agreement, 5 disagreement, 4 a run failed.
       std::vector<std::string> args{"--floedem", floedem::own_executable(), "--out", report_out};

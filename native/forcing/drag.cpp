@@ -32,8 +32,8 @@ std::vector<AreaPoint> area_points(const std::vector<Vec2>& poly) {
   return out;
 }
 
-void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double scale, double c,
-                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& s) {
+void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double scale, double c, Vec2 flow, Vec2 v,
+                   double w, Rot rot, const DragSettings& s, bool jacobian) {
   for (const EdgePoint& e : edges) {
     const Vec2 r = rot.apply(scale * e.r);
     const Vec2 n = rot.apply(e.normal);
@@ -51,14 +51,21 @@ void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double sca
     } else {
       // dF = k (-u.n) u,  dF/du = k ((-u.n) I - u n^T).
       f = (-k * un) * u;
+      if (!jacobian) {
+        sum.add_point_force(r, f, s.rotational);
+        continue;
+      }
       a = {k * (-un - u.x * n.x), -k * u.x * n.y, -k * u.y * n.x, k * (-un - u.y * n.y)};
     }
-    sum.add_point_force(r, f, a, s.rotational);
+    if (jacobian)
+      sum.add_point_force(r, f, a, s.rotational);
+    else
+      sum.add_point_force(r, f, s.rotational);
   }
 }
 
-void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double scale, double c,
-                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& s) {
+void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double scale, double c, Vec2 flow, Vec2 v,
+                   double w, Rot rot, const DragSettings& s, bool jacobian) {
   for (const AreaPoint& p : points) {
     const Vec2 r = rot.apply(scale * p.r);
     const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
@@ -72,10 +79,17 @@ void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double sc
       // dF = k |u| u,  dF/du = k (|u| I + u u^T / |u|).
       const double m = length(u);
       f = (k * m) * u;
+      if (!jacobian) {
+        sum.add_point_force(r, f, s.rotational);
+        continue;
+      }
       const double inv = m > 0.0 ? 1.0 / m : 0.0;
       a = {k * (m + u.x * u.x * inv), k * u.x * u.y * inv, k * u.x * u.y * inv, k * (m + u.y * u.y * inv)};
     }
-    sum.add_point_force(r, f, a, s.rotational);
+    if (jacobian)
+      sum.add_point_force(r, f, a, s.rotational);
+    else
+      sum.add_point_force(r, f, s.rotational);
   }
 }
 
@@ -83,12 +97,54 @@ DistributedDrag::DistributedDrag(std::string_view name, Kind kind, const Environ
     : name_(name), kind_(kind), settings_{environment.rotational_damping, environment.drag_reference_speed} {}
 
 void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_polygon, std::vector<DragSlab> slabs) {
-  Entry e{body, {}, {}, std::move(slabs)};
+  Entry e{body, {}, {}, std::move(slabs), {}};
   if (kind_ == Kind::form)
     e.edges = edge_points(local_polygon);
   else
     e.points = area_points(local_polygon);
+  // Moments sum |k_p| |r_p|^j (j = 0..3) of each slab's quadrature weights, for the rate bound.
+  for (const DragSlab& slab : e.slabs) {
+    std::array<double, 4> m{};
+    auto add = [&](double k, Vec2 r) {
+      const double d = length(slab.scale * r);
+      m[0] += std::abs(k);
+      m[1] += std::abs(k) * d;
+      m[2] += std::abs(k) * d * d;
+      m[3] += std::abs(k) * d * d * d;
+    };
+    for (const EdgePoint& p : e.edges) add(slab.c * slab.scale * p.length, p.r);
+    for (const AreaPoint& p : e.points) add(slab.c * slab.scale * slab.scale * p.area, p.r);
+    e.moments.push_back(m);
+  }
   entries_.push_back(std::move(e));
+}
+
+bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const {
+  // Per quadrature point, with m = |u| <= |V - v| + |w| |r| and k its weight (MODEL.md 2):
+  //   skin  a = k (m I + u u^T / m):    |a_00| + |a_01| <= (1 + sqrt 2) |k| m,  g^T a g <= 2 |k| m |r|^2
+  //   form  a = k (-(u.n) I - u n^T):   the same two bounds (|u.n| <= m, |n_x| + |n_y| <= sqrt 2)
+  //   linearised (m -> U_ref):          |k| U_ref and |k| U_ref |r|^2
+  // where g = k x r maps the spin to the point's velocity, so summing over the points bounds
+  // the row sums of D's translational block and |D_ww| (forcing.cpp's stiffness test).
+  constexpr double kRow = 1.0 + 1.4142135623730951;
+  for (const Entry& e : entries_) {
+    const Vec2 v = s.velocity[e.body];
+    const double w = std::abs(s.angular_velocity[e.body]);
+    std::array<double, 2>& b = sums.rate_bound[e.body];
+    for (std::size_t k = 0; k < e.slabs.size(); ++k) {
+      const std::array<double, 4>& m = e.moments[k];
+      if (settings_.reference_speed > 0.0) {
+        b[0] += settings_.reference_speed * m[0];
+        b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
+        continue;
+      }
+      const double du = length(e.slabs[k].flow - v);
+      const double spin = settings_.rotational ? w : 0.0;
+      b[0] += kRow * (du * m[0] + spin * m[1]);
+      b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
+    }
+  }
+  return true;
 }
 
 bool DistributedDrag::adds_nothing(const Entry& e, Vec2 v, double w) const {
@@ -108,13 +164,14 @@ void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
     const Vec2 v = s.velocity[e.body];
     const double w = s.angular_velocity[e.body];
     if (adds_nothing(e, v, w)) continue;
-    const Rot rot = Rot::from_angle(s.angle[e.body]);
+    const Rot rot = sums.rotation[e.body];
+    const bool jacobian = sums.jacobian[e.body] != 0;
     BodySum sum = sums.load(e.body);
     for (const DragSlab& slab : e.slabs) {
       if (kind_ == Kind::form)
-        add_form_drag(sum, e.edges, slab.scale, slab.c, slab.flow, v, w, rot, settings_);
+        add_form_drag(sum, e.edges, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
       else
-        add_skin_drag(sum, e.points, slab.scale, slab.c, slab.flow, v, w, rot, settings_);
+        add_skin_drag(sum, e.points, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
     }
     sums.store(e.body, sum);
   }

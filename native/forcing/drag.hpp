@@ -35,14 +35,15 @@ struct DragSettings {
   double reference_speed = 0.0;  ///< > 0: |u| replaced by this (linearised drag)
 };
 
+/// `jacobian` false: Q alone (the body cannot be stiff this step), the same Q to the bit.
 /// Adds form drag of a slab (height h, outline scaled by s) in the flow V: coefficient
 /// c = 1/2 rho C h.
 void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double scale, double c,
-                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings);
+                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings, bool jacobian = true);
 
 /// Adds skin drag over an area (outline scaled by s): coefficient c = rho C.
 void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double scale, double c,
-                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings);
+                   Vec2 flow, Vec2 v, double w, Rot rot, const DragSettings& settings, bool jacobian = true);
 
 /// One layer of a body that feels a drag: its coefficient (1/2 rho C h for form drag, rho C
 /// for skin drag), the scale of the outline, and the flow it sits in.
@@ -62,6 +63,7 @@ class DistributedDrag final : public ForceTerm {
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return name_; }
   void add(const BodyStates& state, double time, ForceSums& sums) const override;
+  bool add_rate_bound(const BodyStates& state, ForceSums& sums) const override;
 
  private:
   struct Entry {
@@ -69,6 +71,7 @@ class DistributedDrag final : public ForceTerm {
     std::vector<EdgePoint> edges;   // form drag
     std::vector<AreaPoint> points;  // skin drag
     std::vector<DragSlab> slabs;
+    std::vector<std::array<double, 4>> moments;  // per slab: sum |k| |r|^j, j = 0..3 (rate bound)
   };
   bool adds_nothing(const Entry& e, Vec2 v, double w) const;
 

@@ -7,6 +7,7 @@
 // built, so it costs nothing. The same terms drive every engine, so that engines differ only
 // in contact. Adding a term: one source file with a builder, and one line in forcing.cpp.
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -23,6 +24,13 @@ namespace floedem {
 struct BodySum {
   std::array<double, 3> q;
   std::array<double, 9> d;
+  /// Adds the force f acting at offset r (world) from the centroid without its Jacobian (a
+  /// body whose drag cannot be stiff this step, see ForceTerm::add_rate_bound).
+  void add_point_force(Vec2 r, Vec2 f, bool with_torque) {
+    q[0] += f.x;
+    q[1] += f.y;
+    if (with_torque) q[2] += cross(r, f);
+  }
   /// Adds the force f acting at offset r (world) from the centroid, with dF/du = a (2x2,
   /// row-major) where u = flow - (v + w k x r): Q += G^T f, dQ/dq -= G^T a G, G = [I, k x r].
   void add_point_force(Vec2 r, Vec2 f, const std::array<double, 4>& a, bool with_torque) {
@@ -54,6 +62,17 @@ struct ForceSums {
   std::vector<double> rotation_rate;      ///< f of -m f k x v (1/s); treated exactly, see forcing.cpp
   bool any_jacobian = false;
   bool any_rotation = false;
+  /// Each body's rotation at the start of the step, Rot::from_angle(angle): set by Forcing
+  /// before the terms add (one sin/cos per body that turned since the last step, not one per
+  /// term), for the terms to read.
+  std::vector<Rot> rotation;
+  /// Per body: whether the terms add dQ/dq (set by Forcing before they add). Zero where the
+  /// terms' bound on dt |D| / M shows that the step is explicit whatever D is: D is then never
+  /// read, and a term adds Q alone (the same Q to the bit).
+  std::vector<std::uint8_t> jacobian;
+  /// Per body, filled by ForceTerm::add_rate_bound: upper bounds on the row sums of the
+  /// translational block of -D (N s/m) and on |D_ww| (N m s).
+  std::vector<std::array<double, 2>> rate_bound;
 
   void add_force(std::size_t i, Vec2 f, double torque) {
     q[i][0] += f.x;
@@ -82,6 +101,11 @@ class ForceTerm {
   virtual std::string_view name() const = 0;
   /// Adds this term at the start of a step at `time`.
   virtual void add(const BodyStates& state, double time, ForceSums& sums) const = 0;
+  /// Adds to sums.rate_bound, per body, upper bounds of what this term adds to the row sums
+  /// max(|D_xx| + |D_xy|, |D_yx| + |D_yy|) and to |D_ww| of the Jacobian at this state, and
+  /// returns true; or returns false when it cannot bound them (then every body gets the full
+  /// Jacobian). A term that adds no Jacobian returns true and adds nothing.
+  virtual bool add_rate_bound(const BodyStates&, ForceSums&) const { return false; }
   /// True for a term that only adds a constant rotation rate (Coriolis): a scene whose terms
   /// are all such takes a precomputed per-body path (Forcing::evaluate).
   virtual bool constant_rotation_only() const { return false; }
@@ -114,6 +138,7 @@ class Forcing {
   ForceSums sums_;
   Loads loads_;
   BodyStates moved_;  ///< the state with prescribed velocities (towing scenes only)
+  std::vector<double> rotated_angle_;  ///< the angle sums_.rotation[i] was computed for
   std::vector<double> cached_rate_, cached_tan_, cached_half_tan_;  ///< Coriolis turn per body
   struct BodyHot {
     bool moves = false;  ///< neither fixed nor prescribed

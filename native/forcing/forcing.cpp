@@ -20,6 +20,7 @@
 // M_e the mass they move (m, or m_I when added mass enters contacts).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "forcing/force_term.hpp"
 
@@ -76,6 +77,10 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
   sums_.q.resize(n);
   sums_.dq.resize(n);
   sums_.rotation_rate.resize(n);
+  sums_.rotation.resize(n);
+  sums_.jacobian.assign(n, 1);
+  sums_.rate_bound.resize(n);
+  rotated_angle_.assign(n, std::numeric_limits<double>::quiet_NaN());  // NaN: none computed yet
   cached_rate_.assign(n, 0.0);
   cached_tan_.assign(n, 0.0);
   cached_half_tan_.assign(n, 0.0);
@@ -150,6 +155,23 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
     at = &moved_;
   }
 
+  for (std::size_t i = 0; i < hot_.size(); ++i)
+    if (at->angle[i] != rotated_angle_[i]) {  // the body turned (or the first step)
+      sums_.rotation[i] = Rot::from_angle(at->angle[i]);
+      rotated_angle_[i] = at->angle[i];
+    }
+  // Which bodies need D: where the terms' bound on dt |D| / M stays below the explicit limit,
+  // stiff() would find the body explicit whatever D is, so D is not computed (the terms then
+  // skip its nine products per quadrature point). The margin covers rounding in the sums.
+  std::fill(sums_.rate_bound.begin(), sums_.rate_bound.end(), std::array<double, 2>{});
+  bool bounded = true;
+  for (const auto& t : terms_) bounded = t->add_rate_bound(*at, sums_) && bounded;
+  for (std::size_t i = 0; i < hot_.size(); ++i) {
+    const BodyHot& h = hot_[i];
+    const std::array<double, 2>& b = sums_.rate_bound[i];
+    const double rate = std::max(b[0] / h.mass_with_added, b[1] / h.inertia_with_added);
+    sums_.jacobian[i] = !bounded || (h.moves && dt_ * rate * (1.0 + 1e-6) > kExplicitLimit);
+  }
   std::fill(sums_.q.begin(), sums_.q.end(), std::array<double, 3>{});
   if (sums_.any_jacobian) std::fill(sums_.dq.begin(), sums_.dq.end(), std::array<double, 9>{});
   if (sums_.any_rotation) std::fill(sums_.rotation_rate.begin(), sums_.rotation_rate.end(), 0.0);

@@ -24,10 +24,11 @@ class WaveRadiation final : public ForceTerm {
   }
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return "wave_radiation"; }
-  void add(const BodyStates& s, double, ForceSums& sums) const override {
+  bool add_rate_bound(const BodyStates&, ForceSums&) const override { return true; }  // no Jacobian
+  void add(const BodyStates&, double, ForceSums& sums) const override {
     for (const Entry& e : entries_) {
       // Facing length = extent of the polygon across the wave direction.
-      const Vec2 across = Rot::from_angle(s.angle[e.body]).apply_inverse(perp(direction_));
+      const Vec2 across = sums.rotation[e.body].apply_inverse(perp(direction_));
       double lo = 1e300, hi = -1e300;
       for (const Vec2 p : e.polygon) {
         lo = std::min(lo, dot(p, across));
