@@ -20,24 +20,35 @@ class Run:
     seconds: float = 0.0        # wall time, filled in by run_all
     error: str = ""             # stderr of a failed run
     meta: dict = field(default_factory=dict)   # what the section needs to read it back
+    bench_window: float = 0.0   # > 0: a timing run, `floedem bench --window W`, into TAG.csv,
+                                # made after the others, alone (nothing else shares the cores)
+
+    @property
+    def timed(self):
+        return self.bench_window > 0.0
 
     def command(self, floedem):
-        cmd = [floedem, "run", self.scenario, "-e", self.engine, "-o", self.out, "-q"]
+        if self.timed:
+            cmd = [floedem, "bench", self.scenario, "-e", self.engine, "--window", repr(self.bench_window),
+                   "--csv", self.out, "-q"]
+        else:
+            cmd = [floedem, "run", self.scenario, "-e", self.engine, "-o", self.out, "-q"]
         for s in self.sets:
             cmd += ["--set", s]
         return cmd
 
 
 def run_all(runs, floedem, runs_dir, jobs, label="report"):
-    """Runs every Run (longest first, `jobs` at a time) into runs_dir. Prints one line per
-    finished run. Returns the runs that failed."""
+    """Runs every Run (longest first, `jobs` at a time) into runs_dir, then the timing runs one
+    at a time. Prints one line per finished run. Returns the runs that failed."""
     os.makedirs(runs_dir, exist_ok=True)
     for r in runs:
-        r.out = os.path.join(runs_dir, r.tag + ".h5")
+        r.out = os.path.join(runs_dir, r.tag + (".csv" if r.timed else ".h5"))
         for stale in (r.out, r.out + ".partial"):
             if os.path.exists(stale):
                 os.remove(stale)
-    order = sorted(runs, key=lambda r: -r.cost)
+    order = sorted([r for r in runs if not r.timed], key=lambda r: -r.cost)
+    timed = [r for r in runs if r.timed]
     start = time.monotonic()
     done = 0
     failed = []
@@ -50,16 +61,21 @@ def run_all(runs, floedem, runs_dir, jobs, label="report"):
             r.error = f"exit {p.returncode}: {p.stderr.strip()}"
         return r
 
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        futures = [pool.submit(one, r) for r in order]
-        for future in concurrent.futures.as_completed(futures):
-            r = future.result()
-            done += 1
-            status = "ok" if not r.error else ("failed" if r.meta.get("may_fail") else "FAILED")
-            print(f"[{label} {done:4d}/{len(runs)}] {r.seconds:7.1f} s  {status:6s} {r.tag} ({r.engine})"
-                  f"   elapsed {time.monotonic() - start:6.0f} s", flush=True)
-            if r.error and not r.meta.get("may_fail"):
-                print(f"    {' '.join(r.command(floedem))}\n    {r.error}", file=sys.stderr, flush=True)
-            if r.error:
-                failed.append(r)
+    def finished():
+        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            futures = [pool.submit(one, r) for r in order]
+            for future in concurrent.futures.as_completed(futures):
+                yield future.result()
+        for r in timed:   # alone: a timing shares the machine with nothing of ours
+            yield one(r)
+
+    for r in finished():
+        done += 1
+        status = "ok" if not r.error else ("failed" if r.meta.get("may_fail") else "FAILED")
+        print(f"[{label} {done:4d}/{len(runs)}] {r.seconds:7.1f} s  {status:6s} {r.tag} ({r.engine})"
+              f"   elapsed {time.monotonic() - start:6.0f} s", flush=True)
+        if r.error and not r.meta.get("may_fail"):
+            print(f"    {' '.join(r.command(floedem))}\n    {r.error}", file=sys.stderr, flush=True)
+        if r.error:
+            failed.append(r)
     return failed

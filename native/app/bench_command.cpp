@@ -1,12 +1,12 @@
 #include "app/bench_command.hpp"
 
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -55,6 +55,17 @@ std::string field(const std::string& s) {
   std::string q = "\"";
   for (const char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";
+}
+
+/// Peak resident memory of this process image, MB: VmHWM of /proc/self/status. Not getrusage's
+/// ru_maxrss, which Linux carries over an exec from the parent (a Python harness's 70 MB would
+/// show as this run's peak).
+double peak_resident_mb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::strtod(line.c_str() + 6, nullptr) / 1024.0;  // kB
+  return std::nan("");
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -134,8 +145,7 @@ int run_bench_command(const BenchCommand& c) {
   double mean = 0.0;
   for (const double x : ms) mean += x;
   mean /= static_cast<double>(std::max<std::size_t>(ms.size(), 1));
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
+  const double peak_mb = peak_resident_mb();
 
   std::string overrides;
   for (const std::string& o : c.overrides) overrides += (overrides.empty() ? "" : " ") + o;
@@ -148,7 +158,7 @@ int run_bench_command(const BenchCommand& c) {
       << percentile(ms, 0.9) << ',' << setup << ',' << total << ',' << contact_fraction_sum / static_cast<double>(timed)
       << ',' << max_penetration << ',' << (overlaps > 0 ? penetration_sum / static_cast<double>(overlaps) : 0.0) << ','
       << static_cast<double>(allocations) / static_cast<double>(timed) << ','
-      << static_cast<double>(usage.ru_maxrss) / 1024.0;
+      << peak_mb;
   std::cout << kHeader << '\n' << row.str() << '\n';
   if (!c.csv.empty()) {
     const bool fresh = !std::filesystem::exists(c.csv) || std::filesystem::file_size(c.csv) == 0;

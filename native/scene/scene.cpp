@@ -106,14 +106,17 @@ Vec2 TowSpec::acceleration_at(double t) const {
 }
 
 Vec2 TowSpec::displacement(double t0, double t1) const {
-  // Exact for a piecewise-linear velocity: trapezoids between the path's corners.
-  std::vector<double> cuts{t0};
-  for (const auto& [t, v] : path)
-    if (t > t0 && t < t1) cuts.push_back(t);
-  cuts.push_back(t1);
+  // Exact for a piecewise-linear velocity: trapezoids between the path's corners inside
+  // (t0, t1). No list of cuts is built: called every step, it allocates nothing.
   Vec2 d;
-  for (std::size_t k = 1; k < cuts.size(); ++k)
-    d += (0.5 * (cuts[k] - cuts[k - 1])) * (velocity_at(cuts[k - 1]) + velocity_at(cuts[k]));
+  double from = t0;
+  auto trapezoid = [&](double to) {
+    d += (0.5 * (to - from)) * (velocity_at(from) + velocity_at(to));
+    from = to;
+  };
+  for (const auto& [t, v] : path)
+    if (t > t0 && t < t1) trapezoid(t);
+  trapezoid(t1);
   return d;
 }
 

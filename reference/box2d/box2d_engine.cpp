@@ -66,7 +66,11 @@ class Box2dEngine final : public Engine, public b2ContactListener {
   b2World world_{b2Vec2(0.0f, 0.0f)};
   std::vector<b2Body*> bodies_;
   std::unordered_map<const b2Body*, std::int32_t> index_;
-  std::unordered_map<const b2Contact*, std::array<double, 2>> approach_;
+  // Approach velocities by contact, filled in PreSolve (collide phase) and looked up in
+  // PostSolve (solve phase, another order): a vector sorted once between the two, so that a
+  // step allocates nothing once it has grown (a hash map allocated a node per contact).
+  std::vector<std::pair<const b2Contact*, std::array<double, 2>>> approach_;
+  bool approach_sorted_ = false;
   std::vector<ContactRecord> records_;
   BodyStates state_;
 };
@@ -145,7 +149,8 @@ void Box2dEngine::PreSolve(b2Contact* contact, const b2Manifold*) {
   std::array<double, 2> u{0.0, 0.0};
   for (int k = 0; k < contact->GetManifold()->pointCount; ++k)
     u[k] = dot(point_velocity(b, wm.points[k]) - point_velocity(a, wm.points[k]), Vec2{wm.normal.x, wm.normal.y});
-  approach_[contact] = u;
+  approach_.emplace_back(contact, u);
+  approach_sorted_ = false;
 }
 
 void Box2dEngine::PostSolve(b2Contact* contact, const b2ContactImpulse* impulse) {
@@ -155,7 +160,13 @@ void Box2dEngine::PostSolve(b2Contact* contact, const b2ContactImpulse* impulse)
   const std::int32_t ib = index_.at(contact->GetFixtureB()->GetBody());
   const Vec2 n{wm.normal.x, wm.normal.y};  // from A to B
   const Vec2 t{n.y, -n.x};                 // Box2D's tangent: b2Cross(normal, 1)
-  const auto found = approach_.find(contact);
+  if (!approach_sorted_) {
+    std::sort(approach_.begin(), approach_.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    approach_sorted_ = true;
+  }
+  const auto at = std::lower_bound(approach_.begin(), approach_.end(), contact,
+                                   [](const auto& x, const b2Contact* c) { return x.first < c; });
+  const std::array<double, 2>* found = at != approach_.end() && at->first == contact ? &at->second : nullptr;
   // impulse->count, not the manifold's point count: Box2D solves a two-point manifold whose
   // block system is ill-conditioned as one point (b2ContactSolver sets pointCount = 1) and then
   // reports one impulse; the second slot is left uninitialised (read here, it made runs differ).
@@ -174,7 +185,7 @@ void Box2dEngine::PostSolve(b2Contact* contact, const b2ContactImpulse* impulse)
     r.normal = normal;
     r.normal_impulse = dot(on_b, normal);
     r.tangent_impulse = dot(on_b, perp(normal));
-    r.approach_velocity = found != approach_.end() ? found->second[k] : 0.0;
+    r.approach_velocity = found ? (*found)[k] : 0.0;
     r.separation = wm.separations[k];
     r.kind = r.approach_velocity < -threshold_ ? ContactKind::collision : ContactKind::resting;
     records_.push_back(r);

@@ -1,0 +1,141 @@
+"""Speed (issue 8): wall time per step of the field benchmark (scenarios/bench/field_wall_*.toml:
+floes 5-30 m at 50 % drifting onto a wall until nearly every floe touches another) and of the
+paper's towing case, on every engine, by `floedem bench`: one run at a time after all other runs
+of the report, one process per run, the median over the timed window (the packed state), with
+allocations per step and peak memory. Each run's CSV row is in runs/TAG.csv and all rows in
+bench.csv. The issue's targets are shown against what was measured; they are goals for the
+solver, not agreement checks, so a target missed is reported here and is not a disagreement.
+
+Penetration is shown beside the time: an engine that is faster by letting floes overlap more
+has not won (the issue asks equal or smaller penetration)."""
+import csv
+import os
+
+from report_runner import Run
+
+SIZES = ["1k", "4k", "16k", "100k"]
+TARGET_VS = {"box2d": 3.0, "bullet": 6.0}     # native at least this much faster at N = 16 000
+TARGET_100K_MS = 80.0                          # ms per step for 10^5 floes, native
+TARGET_TOWING = {"ode": 10.0, "bullet": 10.0}  # native at least 10x faster on the towing case
+
+
+def config(quick):
+    if quick:   # a smoke run of the machinery: the field is not packed yet at 40 s
+        return dict(field=[("1k", 40.0, 20.0)], towing=(60.0, 30.0))
+    return dict(field=[("1k", 150.0, 50.0), ("4k", 150.0, 50.0), ("16k", 150.0, 50.0), ("100k", 120.0, 20.0)],
+                towing=(300.0, 240.0))
+
+
+def plan(ctx):
+    c = config(ctx.quick)
+    runs = []
+    for size, duration, window in c["field"]:
+        engines = ctx.engines if size != "100k" else ["native"]
+        for e in engines:
+            runs.append(Run(f"speed_field_{size}_{e}", os.path.join(ctx.scenarios, "bench", f"field_wall_{size}.toml"), e,
+                            [f"run.duration={duration!r}"], bench_window=window,
+                            meta=dict(scene="field", size=size)))
+    duration, window = c["towing"]
+    for e in ctx.engines:
+        runs.append(Run(f"speed_towing_{e}", os.path.join(ctx.scenarios, "towing_paper.toml"), e,
+                        [f"run.duration={duration!r}"], bench_window=window, meta=dict(scene="towing")))
+    return runs
+
+
+def read_row(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    return rows[-1]
+
+
+def write(ctx):
+    timed = [r for r in ctx.all_runs if r.timed and r.tag.startswith("speed_")]
+    rows = {r.tag: read_row(r.out) for r in timed}
+    # All rows in one CSV per report (the machine is in each row).
+    with open(os.path.join(ctx.out, "bench.csv"), "w", newline="") as f:
+        w = None
+        for tag in sorted(rows):
+            if w is None:
+                w = csv.DictWriter(f, fieldnames=list(rows[tag].keys()))
+                w.writeheader()
+            w.writerow(rows[tag])
+    any_row = next(iter(rows.values()))
+    md = ["## Speed", "",
+          f"`floedem bench`, one run at a time on {any_row['cpu']} ({any_row['host']}), single thread per engine; "
+          "median wall time per step over the timed window (p10-p90 beside it). The field benchmark is "
+          "`scenarios/bench/field_wall_*.toml`; the towing case is `scenarios/towing_paper.toml`. "
+          "All rows: `bench.csv`.", ""]
+    if ctx.quick:
+        md += ["(--quick: the 1 000-floe field over 40 s, timed over its last 20 s, before the pack has formed; the "
+               "full report times the packed field at 1 000 to 100 000 floes.)", ""]
+    md += ["| scene | engine | bodies | ms per step (median) | p10-p90 | x native | floes in contact | "
+           "max penetration (mm) | allocations per step | peak memory (MB) |", "|---|---|---|---|---|---|---|---|---|---|"]
+    native_ms = {}
+    for tag, row in sorted(rows.items(), key=lambda kv: (kv[0].split("_")[1], int(kv[1]["bodies"]))):
+        if row["engine"] == "native":
+            native_ms[(tag.rsplit("_", 1)[0])] = float(row["median_ms"])
+    for tag, row in sorted(rows.items(), key=lambda kv: (kv[0].split("_")[1], int(kv[1]["bodies"]),
+                                                          ctx.engines.index(kv[1]["engine"]))):
+        base = native_ms.get(tag.rsplit("_", 1)[0])
+        ratio = float(row["median_ms"]) / base if base else float("nan")
+        md.append(f"| {tag.split('_')[1]}{' ' + tag.split('_')[2] if tag.startswith('speed_field') else ''} "
+                  f"| {row['engine']} | {row['bodies']} | {float(row['median_ms']):.2f} | "
+                  f"{float(row['p10_ms']):.2f}-{float(row['p90_ms']):.2f} | {ratio:.2f} | "
+                  f"{100 * float(row['contact_fraction']):.1f} % | {1e3 * float(row['max_penetration_m']):.2f} | "
+                  f"{float(row['allocations_per_step']):.3g} | {float(row['peak_rss_mb']):.0f} |")
+    md.append("")
+    md += targets(rows)
+    figure(ctx, rows)
+    md += ["![ms per step against floes](fig/speed_field.png)", ""]
+    return md, []
+
+
+def targets(rows):
+    """The issue's targets against what this report measured."""
+    def ms(tag):
+        return float(rows[tag]["median_ms"]) if tag in rows else None
+
+    out = ["Issue 8's targets, as measured here:", ""]
+
+    def versus(scene, targets, label):
+        mine = ms(f"speed_{scene}_native")
+        for e, factor in targets.items():
+            other = ms(f"speed_{scene}_{e}")
+            if mine and other:
+                out.append(f"- {label}: native {other / mine:.2f}x faster than {e} (target {factor:g}x): "
+                           f"{'met' if other / mine >= factor else 'not met'}.")
+
+    versus("field_16k", TARGET_VS, "16 000 floes")
+    n100 = ms("speed_field_100k_native")
+    if n100:
+        out.append(f"- 100 000 floes: {n100:.1f} ms per step on native (target at most {TARGET_100K_MS:g}): "
+                   f"{'met' if n100 <= TARGET_100K_MS else 'not met'}.")
+    versus("towing", TARGET_TOWING, "towing case")
+    if not any("floes" in x for x in out):
+        out.append("- (the field at 16 000 and 100 000 floes is timed by the full report only)")
+    return out + [""]
+
+
+def figure(ctx, rows):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 4))
+    for e in ctx.engines:
+        pts = sorted((int(r["bodies"]), float(r["median_ms"]), float(r["max_penetration_m"]))
+                     for t, r in rows.items() if t.startswith("speed_field") and r["engine"] == e)
+        if not pts:
+            continue
+        ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=e)
+        bx.loglog([p[0] for p in pts], [1e3 * max(p[2], 1e-6) for p in pts], "o-", label=e)
+    ax.axhline(TARGET_100K_MS, color="grey", lw=0.8, ls=":")
+    ax.set_xlabel("bodies")
+    ax.set_ylabel("ms per step (median)")
+    ax.set_title("field onto a wall, dt 0.05 s, 10 iterations")
+    ax.legend()
+    bx.set_xlabel("bodies")
+    bx.set_ylabel("max penetration over the window (mm)")
+    bx.set_title("what the speed buys")
+    fig.tight_layout()
+    fig.savefig(os.path.join(ctx.fig, "speed_field.png"), dpi=110)
+    plt.close(fig)
