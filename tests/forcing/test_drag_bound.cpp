@@ -1,0 +1,79 @@
+// The drag terms' shortcuts must not change a result: the rate bound that lets a body skip its
+// Jacobian is a true upper bound of what stiff() reads (forcing.cpp), and Q without the
+// Jacobian is Q with it, to the bit.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "forcing/drag.hpp"
+#include "geometry/polygon.hpp"
+
+using namespace floedem;
+
+namespace {
+
+ForceSums sums_for(std::size_t n) {
+  ForceSums s;
+  s.q.assign(n, {});
+  s.dq.assign(n, {});
+  s.rotation_rate.assign(n, 0.0);
+  s.rotation.assign(n, Rot{});
+  s.jacobian.assign(n, 1);
+  s.rate_bound.assign(n, {});
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("drag: the rate bound covers the Jacobian, and Q is the same without it", "[forcing]") {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int cases = 0;
+  for (const bool rotational : {true, false})
+    for (const double reference_speed : {0.0, 0.4})
+      for (const auto kind : {DistributedDrag::Kind::form, DistributedDrag::Kind::skin})
+        for (int trial = 0; trial < 200; ++trial) {
+          EnvironmentSpec env;
+          env.rotational_damping = rotational;
+          env.drag_reference_speed = reference_speed;
+          DistributedDrag drag("test", kind, env);
+          // A random convex polygon about the origin (4 to 9 corners, 2 to 60 m).
+          const int corners = 4 + trial % 6;
+          const double size = 2.0 + 29.0 * (1.0 + u(rng));
+          std::vector<Vec2> poly;
+          for (int k = 0; k < corners; ++k) {
+            const double a = 2.0 * M_PI * (k + 0.4 * u(rng)) / corners;
+            const double r = size * (0.7 + 0.3 * u(rng));
+            poly.push_back({r * std::cos(a), r * std::sin(a)});
+          }
+          const Vec2 c = area_moments(poly).centroid;
+          for (Vec2& p : poly) p = p - c;
+          drag.add_body(0, poly, {{500.0 * (1.0 + u(rng)), 0.5 + u(rng) * 0.4, {u(rng), u(rng)}},
+                                  {3.0 * (1.0 + u(rng)), 1.0, {10.0 * u(rng), 10.0 * u(rng)}}});
+          BodyStates s;
+          s.resize(1);
+          s.velocity[0] = {2.0 * u(rng), 2.0 * u(rng)};
+          s.angular_velocity[0] = 0.05 * u(rng);
+          s.angle[0] = M_PI * u(rng);
+
+          ForceSums full = sums_for(1);
+          full.rotation[0] = Rot::from_angle(s.angle[0]);
+          drag.add(s, 0.0, full);
+          REQUIRE(drag.add_rate_bound(s, full));
+          const auto& d = full.dq[0];
+          const double rows = std::max(std::abs(d[0]) + std::abs(d[1]), std::abs(d[3]) + std::abs(d[4]));
+          // Up to rounding: the linearised bounds are equalities (|k| U_ref summed either way);
+          // forcing.cpp's test carries a margin of 1e-6, far above this.
+          CHECK(rows <= full.rate_bound[0][0] * (1.0 + 1e-12));
+          CHECK(std::abs(d[8]) <= full.rate_bound[0][1] * (1.0 + 1e-12));
+
+          ForceSums lean = sums_for(1);
+          lean.rotation[0] = full.rotation[0];
+          lean.jacobian[0] = 0;
+          drag.add(s, 0.0, lean);
+          CHECK(lean.q[0] == full.q[0]);
+          ++cases;
+        }
+  CHECK(cases == 1600);
+}
