@@ -20,6 +20,7 @@ std::int64_t BroadPhase::Level::cell_y(double y, double y0) const {
 void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::int32_t> body,
                             std::span<const std::uint8_t> fixed, std::vector<PartPair>& out) {
   out.clear();
+  gridded_ = false;
   const auto n = static_cast<std::int32_t>(boxes.size());
   if (n < 2) return;  // a lone body never builds pairs
 
@@ -106,6 +107,10 @@ void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::in
     }
   }
 
+  world_lo_ = world.lo;
+  top_ = top;
+  gridded_ = true;
+
   // The cell, on level lv, that reports pair (i, j): the one holding the intersection's corner.
   auto reporting_cell = [&](const Level& lv, std::int32_t i, std::int32_t j) {
     const double cx = std::max(boxes[i].lo.x, boxes[j].lo.x);
@@ -148,6 +153,22 @@ void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::in
     }
   }
   std::sort(out.begin(), out.end());
+}
+
+void BroadPhase::query(const Aabb& box, std::vector<std::int32_t>& out) const {
+  // Cells are clamped to the grid, so a box reaching beyond it looks in the edge cells, which
+  // hold every part that can overlap it there.
+  for (int l = 0; l <= top_; ++l) {
+    const Level& lv = levels_[l];
+    if (lv.count == 0) continue;
+    const std::int64_t x0 = lv.cell_x(box.lo.x, world_lo_.x), x1 = lv.cell_x(box.hi.x, world_lo_.x);
+    const std::int64_t y0 = lv.cell_y(box.lo.y, world_lo_.y), y1 = lv.cell_y(box.hi.y, world_lo_.y);
+    for (std::int64_t y = y0; y <= y1; ++y)
+      for (std::int64_t x = x0; x <= x1; ++x) {
+        const std::int64_t c = y * lv.nx + x;
+        out.insert(out.end(), lv.items.begin() + lv.cell_start[c], lv.items.begin() + lv.cell_start[c + 1]);
+      }
+  }
 }
 
 }  // namespace floedem

@@ -31,6 +31,12 @@ class BroadPhase {
   void find_pairs(std::span<const Aabb> boxes, std::span<const std::int32_t> body,
                   std::span<const std::uint8_t> fixed, std::vector<PartPair>& out);
 
+  /// Appends to `out` every part whose box, as given to the last find_pairs, may overlap
+  /// `box` (a superset; a part may appear more than once). Only after a find_pairs call that
+  /// built the grid (gridded() true).
+  void query(const Aabb& box, std::vector<std::int32_t>& out) const;
+  bool gridded() const { return gridded_; }
+
  private:
   struct Level {
     double h = 0.0;
@@ -46,6 +52,9 @@ class BroadPhase {
   std::vector<std::uint8_t> level_of_;
   std::vector<Level> levels_;
   std::vector<std::int32_t> cursor_;
+  Vec2 world_lo_;      // the grid's origin at the last build
+  int top_ = 0;        // the coarsest level used at the last build
+  bool gridded_ = false;
 };
 
 }  // namespace floedem

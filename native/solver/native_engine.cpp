@@ -1,5 +1,5 @@
 // The native planar non-smooth DEM. One step, in order (NativeEngine::step):
-//   1. pairs      bounds fattened by each body's reach this step -> broad phase
+//   1. pairs      bounds fattened by each body's reach this step -> coherent broad phase (pair_cache)
 //   2. manifolds  narrow phase per pair, impulses carried over by feature id, contacts classified
 //   3. forces     non-contact loads change velocities (symplectic Euler: v* = v + dt M^-1 F)
 //   4. solve      contact impulses at velocity level (contact_solver.cpp)
@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "solver/broad_phase.hpp"
+#include "solver/pair_cache.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/narrow_phase.hpp"
 #include "solver/part_set.hpp"
@@ -52,7 +53,8 @@ class NativeEngine final : public Engine {
   std::vector<double> angular_reach_;      // per body: dt |w| this step
   std::vector<double> part_reach_;         // per part: how far any of its points can move this step
   std::vector<Aabb> part_boxes_;
-  BroadPhase broad_phase_;
+  std::vector<double> part_margin_;        // per part: room of its fat box in the pair cache
+  PairCache pair_cache_;
   std::vector<PartPair> pairs_;
   std::vector<Manifold> manifolds_, previous_manifolds_;
   std::vector<ContactRecord> records_;
@@ -93,6 +95,7 @@ NativeEngine::NativeEngine(const Scene& scene)
   linear_reach_.resize(n);
   angular_reach_.resize(n);
   part_reach_.resize(parts_.size());
+  part_margin_.resize(parts_.size());
 }
 
 EngineInfo NativeEngine::info() const {
@@ -109,6 +112,8 @@ EngineInfo NativeEngine::info() const {
       {"max_correction", setting_text(settings_.max_correction)},
       {"mean_sweeps_per_step", setting_text(steps_ > 0 ? static_cast<double>(total_sweeps_) / static_cast<double>(steps_) : 0.0)},
       {"cold_restarts", std::to_string(cold_restarts_)},
+      {"broad_phase_rebuilds", std::to_string(pair_cache_.rebuilds())},
+      {"broad_phase_refreshed_parts", std::to_string(pair_cache_.refreshed_parts())},
   };
   return i;
 }
@@ -154,8 +159,11 @@ void NativeEngine::find_pairs(const Loads* loads) {
     part_reach_[k] = linear_reach_[b] + angular_reach_[b] * parts_.radius(static_cast<std::int32_t>(k));
     const double fat = part_reach_[k] + 0.5 * settings_.allowed_penetration;
     part_boxes_[k] = {parts_.boxes()[k].lo - Vec2{fat, fat}, parts_.boxes()[k].hi + Vec2{fat, fat}};
+    // A part that leaves its fat box gets room for about four steps at its present reach and a
+    // tenth of its size besides (so that a floe at rest, or creeping, keeps its box for long).
+    part_margin_[k] = 4.0 * part_reach_[k] + 0.1 * parts_.radius(static_cast<std::int32_t>(k));
   }
-  broad_phase_.find_pairs(part_boxes_, parts_.body(), parts_.immovable(), pairs_);
+  pair_cache_.find_pairs(part_boxes_, part_margin_, parts_.body(), parts_.immovable(), pairs_);
 }
 
 PartGeometry NativeEngine::part_geometry(std::int32_t k) const {

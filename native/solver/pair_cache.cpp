@@ -1,0 +1,92 @@
+#include "solver/pair_cache.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace floedem {
+
+namespace {
+
+bool inside(const Aabb& inner, const Aabb& outer) {
+  return inner.lo.x >= outer.lo.x && inner.lo.y >= outer.lo.y && inner.hi.x <= outer.hi.x && inner.hi.y <= outer.hi.y;
+}
+
+/// The most parts whose fat boxes may change between rebuilds: each of them is tested
+/// directly against the others that changed, so this bounds that quadratic term.
+std::size_t stale_limit(std::size_t n) {
+  return std::min<std::size_t>(n / 8, static_cast<std::size_t>(4.0 * std::sqrt(static_cast<double>(n))) + 64);
+}
+
+}  // namespace
+
+void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> margin,
+                           std::span<const std::int32_t> body, std::span<const std::uint8_t> fixed,
+                           std::vector<PartPair>& out) {
+  const std::size_t n = boxes.size();
+  bool full = fat_.size() != n;
+  if (full) {
+    fat_.resize(n);
+    stale_.assign(n, 0);
+    moved_.assign(n, 0);
+    stale_list_.clear();
+  }
+  moved_list_.clear();
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!full && inside(boxes[k], fat_[k])) continue;
+    const Vec2 m{margin[k], margin[k]};
+    fat_[k] = {boxes[k].lo - m, boxes[k].hi + m};
+    moved_list_.push_back(static_cast<std::int32_t>(k));
+  }
+  refreshed_ += static_cast<std::int64_t>(moved_list_.size());
+  if (!full) {
+    for (const std::int32_t k : moved_list_)
+      if (!stale_[k]) {
+        stale_[k] = 1;
+        stale_list_.push_back(k);
+      }
+    full = stale_list_.size() > stale_limit(n) || !grid_.gridded();
+  }
+  if (full)
+    rebuild(body, fixed);
+  else if (!moved_list_.empty())
+    refresh(body, fixed);
+  // The pairs of this step: candidates whose step boxes overlap (candidates are sorted).
+  out.clear();
+  for (const PartPair& p : candidates_)
+    if (boxes[p.a].overlaps(boxes[p.b])) out.push_back(p);
+}
+
+void PairCache::rebuild(std::span<const std::int32_t> body, std::span<const std::uint8_t> fixed) {
+  grid_.find_pairs(fat_, body, fixed, candidates_);
+  for (const std::int32_t k : stale_list_) stale_[k] = 0;
+  stale_list_.clear();
+  ++rebuilds_;
+}
+
+void PairCache::refresh(std::span<const std::int32_t> body, std::span<const std::uint8_t> fixed) {
+  // New candidates of the parts whose fat box changed this step.
+  for (const std::int32_t k : moved_list_) moved_[k] = 1;
+  fresh_.clear();
+  auto consider = [&](std::int32_t i, std::int32_t j) {
+    if (i == j || body[i] == body[j] || (fixed[i] && fixed[j]) || !fat_[i].overlaps(fat_[j])) return;
+    fresh_.push_back({std::min(i, j), std::max(i, j)});
+  };
+  for (const std::int32_t m : moved_list_) {
+    hits_.clear();
+    grid_.query(fat_[m], hits_);
+    for (const std::int32_t j : hits_)
+      if (!stale_[j]) consider(m, j);  // the grid holds j's present fat box
+    for (const std::int32_t j : stale_list_) consider(m, j);
+  }
+  std::sort(fresh_.begin(), fresh_.end());
+  fresh_.erase(std::unique(fresh_.begin(), fresh_.end()), fresh_.end());
+  // Old candidates of the moved parts go; the rest stay; both lists are sorted: merge.
+  kept_.clear();
+  for (const PartPair& p : candidates_)
+    if (!moved_[p.a] && !moved_[p.b]) kept_.push_back(p);
+  candidates_.resize(kept_.size() + fresh_.size());
+  std::merge(kept_.begin(), kept_.end(), fresh_.begin(), fresh_.end(), candidates_.begin());
+  for (const std::int32_t k : moved_list_) moved_[k] = 0;
+}
+
+}  // namespace floedem
