@@ -116,6 +116,10 @@ void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_
     for (const AreaPoint& p : e.points) add(slab.c * slab.scale * slab.scale * p.area, p.r);
     e.moments.push_back(m);
   }
+  // What the rest test reads, packed: one flow when every slab shares it (a floe's one slab).
+  Quiet q{body, e.slabs.empty() ? Vec2{} : e.slabs.front().flow, true};
+  for (const DragSlab& slab : e.slabs) q.one_flow = q.one_flow && slab.flow.x == q.flow.x && slab.flow.y == q.flow.y;
+  quiet_.push_back(q);
   entries_.push_back(std::move(e));
 }
 
@@ -127,10 +131,13 @@ bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const
   // where g = k x r maps the spin to the point's velocity, so summing over the points bounds
   // the row sums of D's translational block and |D_ww| (forcing.cpp's stiffness test).
   constexpr double kRow = 1.0 + 1.4142135623730951;
-  for (const Entry& e : entries_) {
-    const Vec2 v = s.velocity[e.body];
-    const double w = std::abs(s.angular_velocity[e.body]);
-    std::array<double, 2>& b = sums.rate_bound[e.body];
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    const std::size_t body = quiet_[i].body;
+    const Vec2 v = s.velocity[body];
+    if (adds_nothing(i, v, s.angular_velocity[body])) continue;  // adds nothing to D either
+    const Entry& e = entries_[i];
+    const double w = std::abs(s.angular_velocity[body]);
+    std::array<double, 2>& b = sums.rate_bound[body];
     for (std::size_t k = 0; k < e.slabs.size(); ++k) {
       const std::array<double, 4>& m = e.moments[k];
       if (settings_.reference_speed > 0.0) {
@@ -147,23 +154,27 @@ bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const
   return true;
 }
 
-bool DistributedDrag::adds_nothing(const Entry& e, Vec2 v, double w) const {
+bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
   // A body moving with the flow of every slab, without spin, feels no quadratic drag: u = 0 at
   // every quadrature point, so each point adds exactly zero force and Jacobian (a form-drag
   // point is skipped at u.n = 0; a skin point adds k |u| u = 0). Skipping it is exact, so a
   // field of floes at rest in calm water costs nothing here. Linearised skin drag keeps its
   // Jacobian k U_ref I at u = 0, so it is never skipped.
   if (w != 0.0 || (kind_ == Kind::skin && settings_.reference_speed > 0.0)) return false;
-  for (const DragSlab& slab : e.slabs)
+  const Quiet& q = quiet_[i];
+  if (q.one_flow) return q.flow.x == v.x && q.flow.y == v.y;
+  for (const DragSlab& slab : entries_[i].slabs)
     if (slab.flow.x != v.x || slab.flow.y != v.y) return false;
   return true;
 }
 
 void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
-  for (const Entry& e : entries_) {
-    const Vec2 v = s.velocity[e.body];
-    const double w = s.angular_velocity[e.body];
-    if (adds_nothing(e, v, w)) continue;
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    const std::size_t body = quiet_[i].body;
+    const Vec2 v = s.velocity[body];
+    const double w = s.angular_velocity[body];
+    if (adds_nothing(i, v, w)) continue;
+    const Entry& e = entries_[i];
     const Rot rot = sums.rotation[e.body];
     const bool jacobian = sums.jacobian[e.body] != 0;
     BodySum sum = sums.load(e.body);

@@ -73,12 +73,19 @@ class DistributedDrag final : public ForceTerm {
     std::vector<DragSlab> slabs;
     std::vector<std::array<double, 4>> moments;  // per slab: sum |k| |r|^j, j = 0..3 (rate bound)
   };
-  bool adds_nothing(const Entry& e, Vec2 v, double w) const;
+  /// Entry i's body moves with every slab's flow, without spin: it adds nothing (see drag.cpp).
+  bool adds_nothing(std::size_t i, Vec2 v, double w) const;
+  struct Quiet {
+    std::size_t body;
+    Vec2 flow;      // the slabs' flow, when they share one
+    bool one_flow;
+  };
 
   std::string_view name_;
   Kind kind_;
   DragSettings settings_;
   std::vector<Entry> entries_;
+  std::vector<Quiet> quiet_;  // per entry, what adds_nothing reads (kept apart: read every step)
 };
 
 /// The term, or nullptr when no body needs it.

@@ -1,6 +1,7 @@
 #include "solver/part_set.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace floedem {
 
@@ -26,12 +27,22 @@ PartSet::PartSet(const Scene& scene) {
   world_vertices_.resize(local_vertices_.size());
   world_normals_.resize(local_normals_.size());
   boxes_.resize(body_.size());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  placed_position_.assign(body_.size(), Vec2{nan, nan});
+  placed_rotation_.assign(body_.size(), Rot{});
 }
 
 void PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotation) {
   const std::size_t np = body_.size();
   for (std::size_t k = 0; k < np; ++k) {
     const std::int32_t b = body_[k];
+    // A body that has not moved since its parts were placed (a floe at rest) keeps them: the
+    // same pose gives the same vertices, so nothing is recomputed.
+    if (position[b].x == placed_position_[k].x && position[b].y == placed_position_[k].y &&
+        rotation[b].c == placed_rotation_[k].c && rotation[b].s == placed_rotation_[k].s)
+      continue;
+    placed_position_[k] = position[b];
+    placed_rotation_[k] = rotation[b];
     const Transform x{position[b], rotation[b]};
     const Vec2 first = x.apply(local_vertices_[first_[k]]);
     Aabb box{first, first};

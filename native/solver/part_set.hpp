@@ -35,6 +35,8 @@ class PartSet {
   std::vector<Vec2> world_vertices_, world_normals_;
   std::vector<double> radius_;
   std::vector<Aabb> boxes_;
+  std::vector<Vec2> placed_position_;  // per part: the pose it was last placed at (NaN: never)
+  std::vector<Rot> placed_rotation_;
 };
 
 }  // namespace floedem
