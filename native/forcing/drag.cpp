@@ -1,6 +1,9 @@
 #include "forcing/drag.hpp"
 
+#include <atomic>
 #include <cmath>
+
+#include "parallel/thread_pool.hpp"
 
 namespace floedem {
 
@@ -131,7 +134,8 @@ bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const
   // where g = k x r maps the spin to the point's velocity, so summing over the points bounds
   // the row sums of D's translational block and |D_ww| (forcing.cpp's stiffness test).
   constexpr double kRow = 1.0 + 1.4142135623730951;
-  for (std::size_t i = 0; i < entries_.size(); ++i) {
+  thread_pool().for_blocks(entries_.size(), 512, [&](std::size_t begin, std::size_t end) {
+  for (std::size_t i = begin; i < end; ++i) {
     const std::size_t body = quiet_[i].body;
     const Vec2 v = s.velocity[body];
     if (adds_nothing(i, v, s.angular_velocity[body])) continue;  // adds nothing to D either
@@ -151,6 +155,7 @@ bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const
       b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
     }
   }
+  });
   return true;
 }
 
@@ -169,23 +174,32 @@ bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
 }
 
 void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
-  for (std::size_t i = 0; i < entries_.size(); ++i) {
-    const std::size_t body = quiet_[i].body;
-    const Vec2 v = s.velocity[body];
-    const double w = s.angular_velocity[body];
-    if (adds_nothing(i, v, w)) continue;
-    const Entry& e = entries_[i];
-    const Rot rot = sums.rotation[e.body];
-    const bool jacobian = sums.jacobian[e.body] != 0;
-    BodySum sum = sums.load(e.body);
-    for (const DragSlab& slab : e.slabs) {
-      if (kind_ == Kind::form)
-        add_form_drag(sum, e.edges, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
-      else
-        add_skin_drag(sum, e.points, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
+  // Entries are bodies, one each: blocks of them on the pool's threads write distinct bodies,
+  // each in the same order as one thread would, so the sums do not depend on the threads.
+  std::atomic<bool> any_jacobian{false};
+  thread_pool().for_blocks(entries_.size(), 128, [&](std::size_t begin, std::size_t end) {
+    bool jacobian_here = false;
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t body = quiet_[i].body;
+      const Vec2 v = s.velocity[body];
+      const double w = s.angular_velocity[body];
+      if (adds_nothing(i, v, w)) continue;
+      const Entry& e = entries_[i];
+      const Rot rot = sums.rotation[e.body];
+      const bool jacobian = sums.jacobian[e.body] != 0;
+      BodySum sum = sums.load(e.body);
+      for (const DragSlab& slab : e.slabs) {
+        if (kind_ == Kind::form)
+          add_form_drag(sum, e.edges, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
+        else
+          add_skin_drag(sum, e.points, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
+      }
+      sums.store(e.body, sum);
+      jacobian_here = jacobian_here || jacobian;
     }
-    sums.store(e.body, sum);
-  }
+    if (jacobian_here) any_jacobian.store(true, std::memory_order_relaxed);
+  });
+  if (any_jacobian.load(std::memory_order_relaxed)) sums.any_jacobian = true;
 }
 
 }  // namespace floedem

@@ -80,11 +80,11 @@ struct ForceSums {
     q[i][2] += torque;
   }
   BodySum load(std::size_t i) const { return {q[i], dq[i]}; }
-  /// Stores a body's sum back after a term added point forces to it (so Jacobian entries).
+  /// Stores a body's sum back after a term added point forces to it. Safe from several
+  /// threads for distinct bodies; the term then sets any_jacobian once if it added any.
   void store(std::size_t i, const BodySum& s) {
     q[i] = s.q;
     dq[i] = s.d;
-    any_jacobian = true;
   }
   /// One point force on body i (BodySum::add_point_force); terms that add many points to a
   /// body use load / store around them instead.
@@ -92,6 +92,7 @@ struct ForceSums {
     BodySum s = load(i);
     s.add_point_force(r, f, a, with_torque);
     store(i, s);
+    any_jacobian = true;
   }
 };
 

@@ -23,6 +23,7 @@
 #include <limits>
 
 #include "forcing/force_term.hpp"
+#include "parallel/thread_pool.hpp"
 
 namespace floedem {
 
@@ -180,7 +181,9 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
 
   const std::size_t n = hot_.size();
   const bool first_step = time == 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
+  // Per body, independent: blocks on the pool's threads (the same result on any number).
+  thread_pool().for_blocks(n, 512, [&](std::size_t begin, std::size_t end) {
+  for (std::size_t i = begin; i < end; ++i) {
     const BodyHot& h = hot_[i];
     if (!h.moves) {
       loads_.force[i] = {};
@@ -226,6 +229,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
     loads_.force[i] = {h.engine_mass * dv[0] / dt_, h.engine_mass * dv[1] / dt_};
     loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
   }
+  });
   return &loads_;
 }
 

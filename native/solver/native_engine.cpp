@@ -18,6 +18,7 @@
 #include "solver/narrow_phase.hpp"
 #include "solver/part_set.hpp"
 #include "solver/native_settings.hpp"
+#include "parallel/thread_pool.hpp"
 
 namespace floedem {
 
@@ -56,6 +57,7 @@ class NativeEngine final : public Engine {
   std::vector<double> part_margin_;        // per part: room of its fat box in the pair cache
   PairCache pair_cache_;
   std::vector<PartPair> pairs_;
+  std::vector<Manifold> narrow_;          // per pair this step: the narrow phase's result
   std::vector<Manifold> manifolds_, previous_manifolds_;
   std::vector<ContactRecord> records_;
   // Measured figures, reported by info(): solver work and warm-start fallbacks over the run.
@@ -174,18 +176,29 @@ PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
 void NativeEngine::build_manifolds() {
   std::swap(manifolds_, previous_manifolds_);
   manifolds_.clear();
-  std::size_t old = 0;  // both lists are sorted by (part_a, part_b): a merge carries impulses over
+  // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
+  // function of the pair: the same manifolds on any number of threads).
   const double flip_tolerance = 0.1 * settings_.allowed_penetration;
-  for (const PartPair& pair : pairs_) {
-    Manifold m;
-    m.part_a = pair.a;
-    m.part_b = pair.b;
-    m.body_a = parts_.body()[pair.a];
-    m.body_b = parts_.body()[pair.b];
-    m.friction = contact_.friction;
-    m.restitution = contact_.restitution;
-    const double margin = part_reach_[pair.a] + part_reach_[pair.b] + settings_.allowed_penetration;
-    collide(part_geometry(pair.a), part_geometry(pair.b), margin, flip_tolerance, m);
+  narrow_.resize(pairs_.size());
+  thread_pool().for_blocks(pairs_.size(), 64, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const PartPair pair = pairs_[k];
+      Manifold& m = narrow_[k];
+      m = Manifold{};
+      m.part_a = pair.a;
+      m.part_b = pair.b;
+      m.body_a = parts_.body()[pair.a];
+      m.body_b = parts_.body()[pair.b];
+      m.friction = contact_.friction;
+      m.restitution = contact_.restitution;
+      const double margin = part_reach_[pair.a] + part_reach_[pair.b] + settings_.allowed_penetration;
+      collide(part_geometry(pair.a), part_geometry(pair.b), margin, flip_tolerance, m);
+    }
+  });
+  std::size_t old = 0;  // both lists are sorted by (part_a, part_b): a merge carries impulses over
+  for (std::size_t slot = 0; slot < pairs_.size(); ++slot) {
+    const PartPair pair = pairs_[slot];
+    Manifold& m = narrow_[slot];
     if (m.point_count == 0) continue;
     while (old < previous_manifolds_.size() &&
            PartPair{previous_manifolds_[old].part_a, previous_manifolds_[old].part_b} < pair)
@@ -265,15 +278,16 @@ void NativeEngine::apply_loads(const Loads& loads) {
 }
 
 void NativeEngine::integrate() {
-  const std::size_t nb = bodies_.position.size();
-  for (std::size_t i = 0; i < nb; ++i) {
-    if (!moves_[i]) continue;
-    bodies_.position[i] += dt_ * bodies_.velocity[i];
-    if (bodies_.angular_velocity[i] != 0.0) {
-      bodies_.angle[i] += dt_ * bodies_.angular_velocity[i];
-      bodies_.rotation[i] = Rot::from_angle(bodies_.angle[i]);
+  thread_pool().for_blocks(bodies_.position.size(), 2048, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!moves_[i]) continue;
+      bodies_.position[i] += dt_ * bodies_.velocity[i];
+      if (bodies_.angular_velocity[i] != 0.0) {
+        bodies_.angle[i] += dt_ * bodies_.angular_velocity[i];
+        bodies_.rotation[i] = Rot::from_angle(bodies_.angle[i]);
+      }
     }
-  }
+  });
 }
 
 void NativeEngine::record() {

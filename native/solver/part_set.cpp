@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "parallel/thread_pool.hpp"
+
 namespace floedem {
 
 PartSet::PartSet(const Scene& scene) {
@@ -33,30 +35,32 @@ PartSet::PartSet(const Scene& scene) {
 }
 
 void PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotation) {
-  const std::size_t np = body_.size();
-  for (std::size_t k = 0; k < np; ++k) {
-    const std::int32_t b = body_[k];
-    // A body that has not moved since its parts were placed (a floe at rest) keeps them: the
-    // same pose gives the same vertices, so nothing is recomputed.
-    if (position[b].x == placed_position_[k].x && position[b].y == placed_position_[k].y &&
-        rotation[b].c == placed_rotation_[k].c && rotation[b].s == placed_rotation_[k].s)
-      continue;
-    placed_position_[k] = position[b];
-    placed_rotation_[k] = rotation[b];
-    const Transform x{position[b], rotation[b]};
-    const Vec2 first = x.apply(local_vertices_[first_[k]]);
-    Aabb box{first, first};
-    for (std::int32_t v = first_[k]; v < first_[k + 1]; ++v) {
-      const Vec2 p = x.apply(local_vertices_[v]);
-      world_vertices_[v] = p;
-      world_normals_[v] = x.q.apply(local_normals_[v]);
-      box.lo.x = std::min(box.lo.x, p.x);
-      box.lo.y = std::min(box.lo.y, p.y);
-      box.hi.x = std::max(box.hi.x, p.x);
-      box.hi.y = std::max(box.hi.y, p.y);
+  // Parts are independent: blocks of them on the pool's threads.
+  thread_pool().for_blocks(body_.size(), 1024, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::int32_t b = body_[k];
+      // A body that has not moved since its parts were placed (a floe at rest) keeps them: the
+      // same pose gives the same vertices, so nothing is recomputed.
+      if (position[b].x == placed_position_[k].x && position[b].y == placed_position_[k].y &&
+          rotation[b].c == placed_rotation_[k].c && rotation[b].s == placed_rotation_[k].s)
+        continue;
+      placed_position_[k] = position[b];
+      placed_rotation_[k] = rotation[b];
+      const Transform x{position[b], rotation[b]};
+      const Vec2 first = x.apply(local_vertices_[first_[k]]);
+      Aabb box{first, first};
+      for (std::int32_t v = first_[k]; v < first_[k + 1]; ++v) {
+        const Vec2 p = x.apply(local_vertices_[v]);
+        world_vertices_[v] = p;
+        world_normals_[v] = x.q.apply(local_normals_[v]);
+        box.lo.x = std::min(box.lo.x, p.x);
+        box.lo.y = std::min(box.lo.y, p.y);
+        box.hi.x = std::max(box.hi.x, p.x);
+        box.hi.y = std::max(box.hi.y, p.y);
+      }
+      boxes_[k] = box;
     }
-    boxes_[k] = box;
-  }
+  });
 }
 
 PartGeometry PartSet::geometry(std::int32_t k, Vec2 position, Rot rotation) const {
