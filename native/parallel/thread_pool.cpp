@@ -20,13 +20,14 @@ ThreadPool::~ThreadPool() {
 }
 
 void ThreadPool::take_blocks() {
-  for (std::size_t b; (b = next_.fetch_add(1, std::memory_order_relaxed)) < blocks_;) (*job_)(b);
+  for (std::size_t b; (b = next_.fetch_add(1, std::memory_order_relaxed)) < blocks_;) block_(context_, b);
 }
 
-void ThreadPool::run(std::size_t blocks, const std::function<void(std::size_t)>& block) {
+void ThreadPool::run(std::size_t blocks, void* context, BlockFn block) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    job_ = &block;
+    context_ = context;
+    block_ = block;
     blocks_ = blocks;
     next_.store(0, std::memory_order_relaxed);
     busy_ = workers_.size();
@@ -34,10 +35,11 @@ void ThreadPool::run(std::size_t blocks, const std::function<void(std::size_t)>&
   }
   wake_.notify_all();
   take_blocks();
-  // Every worker leaves the job before the next one is set up (job_ and blocks_ are reused).
+  // Every worker leaves the job before the next one is set up (the job's fields are reused).
   std::unique_lock<std::mutex> lock(mutex_);
   done_.wait(lock, [this] { return busy_ == 0; });
-  job_ = nullptr;
+  context_ = nullptr;
+  block_ = nullptr;
 }
 
 void ThreadPool::work_loop() {

@@ -9,7 +9,6 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
-#include <functional>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -36,18 +35,28 @@ class ThreadPool {
       if (n > 0) fn(std::size_t{0}, n);
       return;
     }
-    run(blocks, [&](std::size_t b) { fn(b * grain, std::min(n, (b + 1) * grain)); });
+    struct Job {
+      F& fn;
+      std::size_t n, grain;
+    } job{fn, n, grain};
+    // A plain function and a pointer, not a std::function: no allocation per loop.
+    run(blocks, &job, [](void* p, std::size_t b) {
+      Job& j = *static_cast<Job*>(p);
+      j.fn(b * j.grain, std::min(j.n, (b + 1) * j.grain));
+    });
   }
 
  private:
-  void run(std::size_t blocks, const std::function<void(std::size_t)>& block);
+  using BlockFn = void (*)(void*, std::size_t);
+  void run(std::size_t blocks, void* context, BlockFn block);
   void work_loop();
   void take_blocks();
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;
-  const std::function<void(std::size_t)>* job_ = nullptr;
+  void* context_ = nullptr;
+  BlockFn block_ = nullptr;
   std::size_t blocks_ = 0;
   std::atomic<std::size_t> next_{0};
   std::size_t busy_ = 0;          // workers inside the current job (under mutex_)
