@@ -22,6 +22,7 @@ class Run:
     meta: dict = field(default_factory=dict)   # what the section needs to read it back
     bench_window: float = 0.0   # > 0: a timing run, `floedem bench --window W`, into TAG.csv,
                                 # made after the others, alone (nothing else shares the cores)
+    threads: int = 0            # FLOEDEM_THREADS; 0: 1 for a timing run, else the cores / jobs
 
     @property
     def timed(self):
@@ -53,9 +54,15 @@ def run_all(runs, floedem, runs_dir, jobs, label="report"):
     done = 0
     failed = []
 
+    cores = os.cpu_count() or 1
+
     def one(r):
+        # Threads per run: runs made side by side share the cores; a timing is single-threaded
+        # unless it says otherwise (the thread-scaling runs).
+        env = dict(os.environ)
+        env["FLOEDEM_THREADS"] = str(r.threads or (1 if r.timed else max(1, cores // max(1, jobs))))
         t0 = time.monotonic()
-        p = subprocess.run(r.command(floedem), capture_output=True, text=True)
+        p = subprocess.run(r.command(floedem), capture_output=True, text=True, env=env)
         r.seconds = time.monotonic() - t0
         if p.returncode != 0:
             r.error = f"exit {p.returncode}: {p.stderr.strip()}"

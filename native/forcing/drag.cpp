@@ -134,7 +134,7 @@ bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const
   // where g = k x r maps the spin to the point's velocity, so summing over the points bounds
   // the row sums of D's translational block and |D_ww| (forcing.cpp's stiffness test).
   constexpr double kRow = 1.0 + 1.4142135623730951;
-  thread_pool().for_blocks(entries_.size(), 512, [&](std::size_t begin, std::size_t end) {
+  thread_pool().for_blocks(entries_.size(), 4096, [&](std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; ++i) {
     const std::size_t body = quiet_[i].body;
     const Vec2 v = s.velocity[body];
@@ -177,7 +177,7 @@ void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
   // Entries are bodies, one each: blocks of them on the pool's threads write distinct bodies,
   // each in the same order as one thread would, so the sums do not depend on the threads.
   std::atomic<bool> any_jacobian{false};
-  thread_pool().for_blocks(entries_.size(), 128, [&](std::size_t begin, std::size_t end) {
+  thread_pool().for_blocks(entries_.size(), 512, [&](std::size_t begin, std::size_t end) {
     bool jacobian_here = false;
     for (std::size_t i = begin; i < end; ++i) {
       const std::size_t body = quiet_[i].body;

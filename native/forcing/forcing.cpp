@@ -182,7 +182,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
   const std::size_t n = hot_.size();
   const bool first_step = time == 0.0;
   // Per body, independent: blocks on the pool's threads (the same result on any number).
-  thread_pool().for_blocks(n, 512, [&](std::size_t begin, std::size_t end) {
+  thread_pool().for_blocks(n, 2048, [&](std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; ++i) {
     const BodyHot& h = hot_[i];
     if (!h.moves) {

@@ -180,7 +180,7 @@ void NativeEngine::build_manifolds() {
   // function of the pair: the same manifolds on any number of threads).
   const double flip_tolerance = 0.1 * settings_.allowed_penetration;
   narrow_.resize(pairs_.size());
-  thread_pool().for_blocks(pairs_.size(), 64, [&](std::size_t begin, std::size_t end) {
+  thread_pool().for_blocks(pairs_.size(), 512, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const PartPair pair = pairs_[k];
       Manifold& m = narrow_[k];
@@ -278,7 +278,7 @@ void NativeEngine::apply_loads(const Loads& loads) {
 }
 
 void NativeEngine::integrate() {
-  thread_pool().for_blocks(bodies_.position.size(), 2048, [&](std::size_t begin, std::size_t end) {
+  thread_pool().for_blocks(bodies_.position.size(), 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       if (!moves_[i]) continue;
       bodies_.position[i] += dt_ * bodies_.velocity[i];

@@ -36,7 +36,7 @@ PartSet::PartSet(const Scene& scene) {
 
 void PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotation) {
   // Parts are independent: blocks of them on the pool's threads.
-  thread_pool().for_blocks(body_.size(), 1024, [&](std::size_t begin, std::size_t end) {
+  thread_pool().for_blocks(body_.size(), 2048, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const std::int32_t b = body_[k];
       // A body that has not moved since its parts were placed (a floe at rest) keeps them: the

@@ -21,9 +21,9 @@ TARGET_TOWING = {"ode": 10.0, "bullet": 10.0}  # native at least 10x faster on t
 
 def config(quick):
     if quick:   # a smoke run of the machinery: the field is not packed yet at 40 s
-        return dict(field=[("1k", 40.0, 20.0)], towing=(60.0, 30.0))
+        return dict(field=[("1k", 40.0, 20.0)], towing=(60.0, 30.0), scaling=("1k", 40.0, 20.0))
     return dict(field=[("1k", 150.0, 50.0), ("4k", 150.0, 50.0), ("16k", 150.0, 50.0), ("100k", 120.0, 20.0)],
-                towing=(300.0, 240.0))
+                towing=(300.0, 240.0), scaling=("4k", 150.0, 50.0))
 
 
 def plan(ctx):
@@ -35,6 +35,15 @@ def plan(ctx):
             runs.append(Run(f"speed_field_{size}_{e}", os.path.join(ctx.scenarios, "bench", f"field_wall_{size}.toml"), e,
                             [f"run.duration={duration!r}"], bench_window=window,
                             meta=dict(scene="field", size=size)))
+    # Thread scaling: native on the field, 1 thread up to every core (results are the same to
+    # the bit on any number; tests/run/test_determinism.cpp).
+    size, duration_s, window_s = c["scaling"]
+    cores = os.cpu_count() or 1
+    for t in sorted({1, 2, 4, 8, 16, cores}):
+        if t <= cores:
+            runs.append(Run(f"speed_threads_{t}", os.path.join(ctx.scenarios, "bench", f"field_wall_{size}.toml"),
+                            "native", [f"run.duration={duration_s!r}"], bench_window=window_s, threads=t,
+                            meta=dict(scene="threads", threads=t)))
     duration, window = c["towing"]
     for e in ctx.engines:
         runs.append(Run(f"speed_towing_{e}", os.path.join(ctx.scenarios, "towing_paper.toml"), e,
@@ -50,15 +59,18 @@ def read_row(path):
 
 def write(ctx):
     timed = [r for r in ctx.all_runs if r.timed and r.tag.startswith("speed_")]
-    rows = {r.tag: read_row(r.out) for r in timed}
+    every = {r.tag: read_row(r.out) for r in timed}
+    rows = {t: r for t, r in every.items() if not t.startswith("speed_threads_")}
+    scaling = sorted((int(r["threads"]), float(r["median_ms"])) for t, r in every.items()
+                     if t.startswith("speed_threads_"))
     # All rows in one CSV per report (the machine is in each row).
     with open(os.path.join(ctx.out, "bench.csv"), "w", newline="") as f:
         w = None
-        for tag in sorted(rows):
+        for tag in sorted(every):
             if w is None:
-                w = csv.DictWriter(f, fieldnames=list(rows[tag].keys()))
+                w = csv.DictWriter(f, fieldnames=list(every[tag].keys()))
                 w.writeheader()
-            w.writerow(rows[tag])
+            w.writerow(every[tag])
     any_row = next(iter(rows.values()))
     md = ["## Speed", "",
           f"`floedem bench`, one run at a time on {any_row['cpu']} ({any_row['host']}), single thread per engine; "
@@ -87,6 +99,15 @@ def write(ctx):
     md += targets(rows)
     figure(ctx, rows)
     md += ["![ms per step against floes](fig/speed_field.png)", ""]
+    if scaling:
+        one = scaling[0][1]
+        md += [f"Threads (native, `{next(r for t, r in every.items() if t.startswith('speed_threads_'))['scenario']}`, "
+               "FLOEDEM_THREADS; the output is the same to the bit on any number): the per-body and per-pair loops "
+               "(drag, forcing, placing, narrow phase, integration) run on the pool, the contact solve is serial, "
+               "so the speed-up is bounded by the solve's share.", "",
+               "| threads | ms per step | speed-up |", "|---|---|---|"]
+        md += [f"| {t} | {ms:.2f} | {one / ms:.2f} |" for t, ms in scaling]
+        md.append("")
     return md, []
 
 
