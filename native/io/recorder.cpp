@@ -13,8 +13,6 @@ namespace floedem {
 
 namespace {
 
-constexpr double kFlushSeconds = 1.0;
-
 /// A dataset that grows along its first dimension: [rows, shape...].
 class Series {
  public:
@@ -130,7 +128,6 @@ struct Recorder::Impl {
   // Contact loads.
   Series load_time, load_force;
   std::vector<double> l_time, l_force;
-  std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false;
   bool write_failed = false;
 
@@ -196,14 +193,13 @@ struct Recorder::Impl {
     }
   }
 
+  /// Writes the buffers and flushes HDF5, so that what is written stays readable if the
+  /// run is killed. Called when a buffer fills (points fixed by the data) and at the end,
+  /// never on the clock: the file's layout, and so its bytes, then do not depend on how fast
+  /// the run went (a flush at a clock-chosen moment moves HDF5's allocations).
   void flush() {
     write_buffers();
     file.flush(H5F_SCOPE_GLOBAL);
-    last_flush = std::chrono::steady_clock::now();
-  }
-
-  void maybe_flush() {
-    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - last_flush).count() >= kFlushSeconds) flush();
   }
 };
 
@@ -395,8 +391,7 @@ void Recorder::write_frame(double time, const BodyStates& state) {
   }
   ++d.buffered_frames;
   try {
-    if (d.buffered_frames >= d.frame_chunk) d.write_buffers();
-    d.maybe_flush();
+    if (d.buffered_frames >= d.frame_chunk) d.flush();
   } catch (const H5::Exception& e) {
     impl_->write_failed = true;
     throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
@@ -422,7 +417,7 @@ void Recorder::write_contacts(double time, std::span<const ContactRecord> contac
     d.k_kind.push_back(static_cast<std::uint8_t>(c.kind));
   }
   try {
-    if (d.k_time.size() >= 4096) d.write_buffers();
+    if (d.k_time.size() >= 4096) d.flush();
   } catch (const H5::Exception& e) {
     impl_->write_failed = true;
     throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
@@ -433,8 +428,7 @@ void Recorder::write_collisions(std::span<const CollisionRow> rows) {
   Impl& d = *impl_;
   d.events.insert(d.events.end(), rows.begin(), rows.end());
   try {
-    if (d.events.size() >= 1024) d.write_buffers();
-    d.maybe_flush();
+    if (d.events.size() >= 1024) d.flush();
   } catch (const H5::Exception& e) {
     impl_->write_failed = true;
     throw OutputError(partial_path_ + ": could not write collisions (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
@@ -449,7 +443,7 @@ void Recorder::write_loads(double time, std::span<const Vec2> forces) {
   Impl& d = *impl_;
   d.l_time.push_back(time);
   for (const Vec2 f : forces) d.l_force.insert(d.l_force.end(), {f.x, f.y});
-  if (d.l_time.size() >= 4096) d.write_buffers();
+  if (d.l_time.size() >= 4096) d.flush();
 }
 
 void Recorder::write_tow(double time, const TowFrame& f) {
@@ -459,7 +453,7 @@ void Recorder::write_tow(double time, const TowFrame& f) {
   d.w_mean.insert(d.w_mean.end(), {f.force_mean.x, f.force_mean.y});
   d.w_ice.insert(d.w_ice.end(), {f.ice_force_mean.x, f.ice_force_mean.y});
   d.w_tug.insert(d.w_tug.end(), {f.tug_position.x, f.tug_position.y});
-  if (d.w_time.size() >= 4096) d.write_buffers();
+  if (d.w_time.size() >= 4096) d.flush();
 }
 
 std::int64_t Recorder::frames() const {

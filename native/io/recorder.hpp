@@ -1,8 +1,8 @@
 #pragma once
 // HDF5 output of a run (layout in README.md, "Output"). Written as the run goes, under
-// RESULT.h5.partial, flushed at least once a second of wall time so that a killed run keeps
-// its recorded frames readable; renamed to RESULT.h5 by finish() only.
-#include <chrono>
+// RESULT.h5.partial, in chunks fixed by the data (so the bytes do not depend on the run's
+// speed), with HDF5 flushed at least once a second of wall time so that a killed run keeps
+// what it wrote readable; renamed to RESULT.h5 by finish() only.
 #include <memory>
 #include <span>
 #include <stdexcept>
