@@ -120,7 +120,8 @@ void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_
     e.moments.push_back(m);
   }
   // What the rest test reads, packed: one flow when every slab shares it (a floe's one slab).
-  Quiet q{body, e.slabs.empty() ? Vec2{} : e.slabs.front().flow, true};
+  Quiet q{body, e.slabs.empty() ? Vec2{} : e.slabs.front().flow, true, e.slabs.size() == 1,
+          e.moments.empty() ? std::array<double, 4>{} : e.moments.front()};
   for (const DragSlab& slab : e.slabs) q.one_flow = q.one_flow && slab.flow.x == q.flow.x && slab.flow.y == q.flow.y;
   quiet_.push_back(q);
   entries_.push_back(std::move(e));
@@ -139,21 +140,26 @@ bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const
     const std::size_t body = quiet_[i].body;
     const Vec2 v = s.velocity[body];
     if (adds_nothing(i, v, s.angular_velocity[body])) continue;  // adds nothing to D either
-    const Entry& e = entries_[i];
     const double w = std::abs(s.angular_velocity[body]);
     std::array<double, 2>& b = sums.rate_bound[body];
-    for (std::size_t k = 0; k < e.slabs.size(); ++k) {
-      const std::array<double, 4>& m = e.moments[k];
+    auto add_slab = [&](const std::array<double, 4>& m, Vec2 flow) {
       if (settings_.reference_speed > 0.0) {
         b[0] += settings_.reference_speed * m[0];
         b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
-        continue;
+        return;
       }
-      const double du = length(e.slabs[k].flow - v);
+      const double du = length(flow - v);
       const double spin = settings_.rotational ? w : 0.0;
       b[0] += kRow * (du * m[0] + spin * m[1]);
       b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
+    };
+    const Quiet& q = quiet_[i];
+    if (q.single) {  // one slab (a floe): all from the packed record, no trip to the entry
+      add_slab(q.moments, q.flow);
+      continue;
     }
+    const Entry& e = entries_[i];
+    for (std::size_t k = 0; k < e.slabs.size(); ++k) add_slab(e.moments[k], e.slabs[k].flow);
   }
   });
   return true;

@@ -79,6 +79,8 @@ class DistributedDrag final : public ForceTerm {
     std::size_t body;
     Vec2 flow;      // the slabs' flow, when they share one
     bool one_flow;
+    bool single;                     // exactly one slab: its moments are here too
+    std::array<double, 4> moments;   // the one slab's (rate bound), when single
   };
 
   std::string_view name_;
