@@ -136,31 +136,31 @@ bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const
   // the row sums of D's translational block and |D_ww| (forcing.cpp's stiffness test).
   constexpr double kRow = 1.0 + 1.4142135623730951;
   thread_pool().for_blocks(entries_.size(), 4096, [&](std::size_t begin, std::size_t end) {
-  for (std::size_t i = begin; i < end; ++i) {
-    const std::size_t body = quiet_[i].body;
-    const Vec2 v = s.velocity[body];
-    if (adds_nothing(i, v, s.angular_velocity[body])) continue;  // adds nothing to D either
-    const double w = std::abs(s.angular_velocity[body]);
-    std::array<double, 2>& b = sums.rate_bound[body];
-    auto add_slab = [&](const std::array<double, 4>& m, Vec2 flow) {
-      if (settings_.reference_speed > 0.0) {
-        b[0] += settings_.reference_speed * m[0];
-        b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
-        return;
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t body = quiet_[i].body;
+      const Vec2 v = s.velocity[body];
+      if (adds_nothing(i, v, s.angular_velocity[body])) continue;  // adds nothing to D either
+      const double w = std::abs(s.angular_velocity[body]);
+      std::array<double, 2>& b = sums.rate_bound[body];
+      auto add_slab = [&](const std::array<double, 4>& m, Vec2 flow) {
+        if (settings_.reference_speed > 0.0) {
+          b[0] += settings_.reference_speed * m[0];
+          b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
+          return;
+        }
+        const double du = length(flow - v);
+        const double spin = settings_.rotational ? w : 0.0;
+        b[0] += kRow * (du * m[0] + spin * m[1]);
+        b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
+      };
+      const Quiet& q = quiet_[i];
+      if (q.single) {  // one slab (a floe): all from the packed record, no trip to the entry
+        add_slab(q.moments, q.flow);
+        continue;
       }
-      const double du = length(flow - v);
-      const double spin = settings_.rotational ? w : 0.0;
-      b[0] += kRow * (du * m[0] + spin * m[1]);
-      b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
-    };
-    const Quiet& q = quiet_[i];
-    if (q.single) {  // one slab (a floe): all from the packed record, no trip to the entry
-      add_slab(q.moments, q.flow);
-      continue;
+      const Entry& e = entries_[i];
+      for (std::size_t k = 0; k < e.slabs.size(); ++k) add_slab(e.moments[k], e.slabs[k].flow);
     }
-    const Entry& e = entries_[i];
-    for (std::size_t k = 0; k < e.slabs.size(); ++k) add_slab(e.moments[k], e.slabs[k].flow);
-  }
   });
   return true;
 }

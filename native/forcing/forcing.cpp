@@ -183,52 +183,52 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
   const bool first_step = time == 0.0;
   // Per body, independent: blocks on the pool's threads (the same result on any number).
   thread_pool().for_blocks(n, 2048, [&](std::size_t begin, std::size_t end) {
-  for (std::size_t i = begin; i < end; ++i) {
-    const BodyHot& h = hot_[i];
-    if (!h.moves) {
-      loads_.force[i] = {};
-      loads_.torque[i] = 0.0;
-      continue;
-    }
-    const double mi = h.mass_with_added;
-    const double ii = h.inertia_with_added;
-    const std::array<double, 3>& q = sums_.q[i];
-    std::array<double, 3> dv;
-    const double f = sums_.any_rotation ? sums_.rotation_rate[i] * h.mass / mi : 0.0;
-    const bool implicit = sums_.any_jacobian && stiff(sums_.dq[i], mi, ii);
-    if (!implicit && f == 0.0) {
-      dv = {dt_ * q[0] / mi, dt_ * q[1] / mi, dt_ * q[2] / ii};
-    } else {
-      // f~ = (2 / dt) tan(angle / 2), so that the Cayley turn is exactly the angle; tan is
-      // cached per body (the rate rarely changes).
-      if (f != cached_rate_[i]) {
-        cached_rate_[i] = f;
-        cached_tan_[i] = std::tan(0.5 * f * dt_);
-        cached_half_tan_[i] = std::tan(0.25 * f * dt_);
+    for (std::size_t i = begin; i < end; ++i) {
+      const BodyHot& h = hot_[i];
+      if (!h.moves) {
+        loads_.force[i] = {};
+        loads_.torque[i] = 0.0;
+        continue;
       }
-      const double ft = (2.0 / dt_) * (first_step ? cached_half_tan_[i] : cached_tan_[i]);
-      const double cv = mi * ft;  // C = cv [[0, -1], [1, 0]] on v
-      const Vec2 v = state.velocity[i];
-      const std::array<double, 3> rhs{q[0] + cv * v.y, q[1] - cv * v.x, q[2]};
-      if (!implicit) {
-        // [[M, -c], [c, M]] dv = rhs with M = m_I / dt, c = cv / 2: closed form.
-        const double m = mi / dt_, c = 0.5 * cv;
-        const double det = m * m + c * c;
-        dv = {(m * rhs[0] + c * rhs[1]) / det, (m * rhs[1] - c * rhs[0]) / det, dt_ * q[2] / ii};
+      const double mi = h.mass_with_added;
+      const double ii = h.inertia_with_added;
+      const std::array<double, 3>& q = sums_.q[i];
+      std::array<double, 3> dv;
+      const double f = sums_.any_rotation ? sums_.rotation_rate[i] * h.mass / mi : 0.0;
+      const bool implicit = sums_.any_jacobian && stiff(sums_.dq[i], mi, ii);
+      if (!implicit && f == 0.0) {
+        dv = {dt_ * q[0] / mi, dt_ * q[1] / mi, dt_ * q[2] / ii};
       } else {
-        std::array<double, 9> a = sums_.dq[i];
-        for (double& x : a) x = -x;
-        a[0] += mi / dt_;
-        a[4] += mi / dt_;
-        a[8] += ii / dt_;
-        a[1] += -0.5 * cv;
-        a[3] += 0.5 * cv;
-        dv = solve3(a, rhs);
+        // f~ = (2 / dt) tan(angle / 2), so that the Cayley turn is exactly the angle; tan is
+        // cached per body (the rate rarely changes).
+        if (f != cached_rate_[i]) {
+          cached_rate_[i] = f;
+          cached_tan_[i] = std::tan(0.5 * f * dt_);
+          cached_half_tan_[i] = std::tan(0.25 * f * dt_);
+        }
+        const double ft = (2.0 / dt_) * (first_step ? cached_half_tan_[i] : cached_tan_[i]);
+        const double cv = mi * ft;  // C = cv [[0, -1], [1, 0]] on v
+        const Vec2 v = state.velocity[i];
+        const std::array<double, 3> rhs{q[0] + cv * v.y, q[1] - cv * v.x, q[2]};
+        if (!implicit) {
+          // [[M, -c], [c, M]] dv = rhs with M = m_I / dt, c = cv / 2: closed form.
+          const double m = mi / dt_, c = 0.5 * cv;
+          const double det = m * m + c * c;
+          dv = {(m * rhs[0] + c * rhs[1]) / det, (m * rhs[1] - c * rhs[0]) / det, dt_ * q[2] / ii};
+        } else {
+          std::array<double, 9> a = sums_.dq[i];
+          for (double& x : a) x = -x;
+          a[0] += mi / dt_;
+          a[4] += mi / dt_;
+          a[8] += ii / dt_;
+          a[1] += -0.5 * cv;
+          a[3] += 0.5 * cv;
+          dv = solve3(a, rhs);
+        }
       }
+      loads_.force[i] = {h.engine_mass * dv[0] / dt_, h.engine_mass * dv[1] / dt_};
+      loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
     }
-    loads_.force[i] = {h.engine_mass * dv[0] / dt_, h.engine_mass * dv[1] / dt_};
-    loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
-  }
   });
   return &loads_;
 }
