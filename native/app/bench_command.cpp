@@ -101,6 +101,7 @@ int run_bench_command(const BenchCommand& c) {
   const double setup = std::chrono::duration<double>(clock::now() - start).count();
 
   const std::int64_t steps = scene.run.steps();
+  if (steps < 1) throw InputError(c.scenario + ": run.duration is shorter than one step of run.dt: nothing to time");
   const std::int64_t timed = c.window > 0.0 ? std::clamp<std::int64_t>(std::llround(c.window / scene.run.dt), 1, steps) : steps;
   const std::int64_t first_timed = steps - timed + 1;
   std::vector<double> ms;

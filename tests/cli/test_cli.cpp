@@ -1,6 +1,7 @@
 // The command line: exit codes, one-line errors, no output left behind on bad input.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -111,4 +112,33 @@ TEST_CASE("cli: help lists the commands and options", "[cli]") {
   r = run("run --help");
   CHECK(r.code == 0);
   for (const char* opt : {"--engine", "--out", "--set"}) CHECK(r.output.find(opt) != std::string::npos);
+}
+
+TEST_CASE("cli: floedem bench prints and appends one CSV row; bad input exits 2", "[cli]") {
+  // Not a timing test: what the row holds (its columns and the achieved figures), not how fast.
+  const fs::path d = dir_for("bench");
+  const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/head_on.toml";
+  const fs::path csv = d / "b.csv";
+  for (int k = 0; k < 2; ++k) {
+    const Result r = run("bench " + scenario + " --window 0.5 --set run.duration=2 --csv " + csv.string() + " -q");
+    CHECK(r.code == 0);
+    CHECK(r.output.find("median_ms") != std::string::npos);
+  }
+  std::ifstream in(csv);
+  std::string header, row, line;
+  std::getline(in, header);
+  int rows = 0;
+  while (std::getline(in, line)) {
+    row = line;
+    ++rows;
+  }
+  CHECK(rows == 2);  // appended, the header once
+  auto columns = [](const std::string& s) { return std::count(s.begin(), s.end(), ',') + 1; };
+  CHECK(columns(header) == columns(row));
+  CHECK(header.rfind("host,cpu,threads,", 0) == 0);
+  CHECK(row.find(",native,floedem,2,2,") != std::string::npos);  // engine, version, bodies, moving
+  CHECK(fs::exists(csv));
+  CHECK(run("bench " + scenario + " --engine nosuch").code == 2);
+  CHECK(run("bench " + (d / "missing.toml").string()).code == 2);
+  fs::remove_all(d);
 }
