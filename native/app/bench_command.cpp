@@ -162,6 +162,9 @@ int run_bench_command(const BenchCommand& c) {
       << peak_mb;
   std::cout << kHeader << '\n' << row.str() << '\n';
   if (!c.csv.empty()) {
+    const std::filesystem::path dir = std::filesystem::path(c.csv).parent_path();
+    if (!dir.empty() && !std::filesystem::is_directory(dir))
+      throw OutputError("cannot append to " + c.csv + ": no directory " + dir.string());
     const bool fresh = !std::filesystem::exists(c.csv) || std::filesystem::file_size(c.csv) == 0;
     std::ofstream out(c.csv, std::ios::app);
     if (fresh) out << kHeader << '\n';
