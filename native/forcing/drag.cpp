@@ -44,21 +44,17 @@ void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double sca
     const double un = dot(u, n);
     if (un >= 0.0) continue;  // the flow leaves this edge: no pressure on it
     const double k = c * scale * e.length;
-    std::array<double, 4> a;
+    std::array<double, 4> a{};  // dF/du, computed only when the body needs its Jacobian
     Vec2 f;
     if (s.reference_speed > 0.0) {
       // Linearised: |u| -> U_ref, so dF = k U_ref cos(theta) u with cos(theta) = -u.n / |u|.
       const double cos_theta = -un / length(u);
       f = (k * s.reference_speed * cos_theta) * u;
-      a = {k * s.reference_speed * cos_theta, 0.0, 0.0, k * s.reference_speed * cos_theta};
+      if (jacobian) a = {k * s.reference_speed * cos_theta, 0.0, 0.0, k * s.reference_speed * cos_theta};
     } else {
       // dF = k (-u.n) u,  dF/du = k ((-u.n) I - u n^T).
       f = (-k * un) * u;
-      if (!jacobian) {
-        sum.add_point_force(r, f, s.rotational);
-        continue;
-      }
-      a = {k * (-un - u.x * n.x), -k * u.x * n.y, -k * u.y * n.x, k * (-un - u.y * n.y)};
+      if (jacobian) a = {k * (-un - u.x * n.x), -k * u.x * n.y, -k * u.y * n.x, k * (-un - u.y * n.y)};
     }
     if (jacobian)
       sum.add_point_force(r, f, a, s.rotational);
@@ -73,21 +69,19 @@ void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double sc
     const Vec2 r = rot.apply(scale * p.r);
     const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
     const double k = c * scale * scale * p.area;
-    std::array<double, 4> a;
+    std::array<double, 4> a{};  // dF/du, computed only when the body needs its Jacobian
     Vec2 f;
     if (s.reference_speed > 0.0) {
       f = (k * s.reference_speed) * u;
-      a = {k * s.reference_speed, 0.0, 0.0, k * s.reference_speed};
+      if (jacobian) a = {k * s.reference_speed, 0.0, 0.0, k * s.reference_speed};
     } else {
       // dF = k |u| u,  dF/du = k (|u| I + u u^T / |u|).
       const double m = length(u);
       f = (k * m) * u;
-      if (!jacobian) {
-        sum.add_point_force(r, f, s.rotational);
-        continue;
+      if (jacobian) {
+        const double inv = m > 0.0 ? 1.0 / m : 0.0;
+        a = {k * (m + u.x * u.x * inv), k * u.x * u.y * inv, k * u.x * u.y * inv, k * (m + u.y * u.y * inv)};
       }
-      const double inv = m > 0.0 ? 1.0 / m : 0.0;
-      a = {k * (m + u.x * u.x * inv), k * u.x * u.y * inv, k * u.x * u.y * inv, k * (m + u.y * u.y * inv)};
     }
     if (jacobian)
       sum.add_point_force(r, f, a, s.rotational);
