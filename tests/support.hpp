@@ -1,10 +1,12 @@
 #pragma once
 // Helpers shared by the tests: scenes from TOML text, engines, polygons as TOML.
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -30,6 +32,15 @@ inline CliResult run_cli(const std::string& args, const std::string& shell_prefi
   while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
   const int status = pclose(p);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+/// An empty directory of its own under the system's temporary directory (per test and process).
+inline std::filesystem::path temp_dir(const std::string& name) {
+  const std::filesystem::path d =
+      std::filesystem::temp_directory_path() / ("floedem-test-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
 }
 
 inline Scene scene_from(const std::string& toml, const std::vector<std::string>& overrides = {}) {

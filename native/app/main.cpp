@@ -13,6 +13,7 @@
 #include "app/python_script.hpp"
 #include "engine/registry.hpp"
 #include "io/recorder.hpp"
+#include "run/resume.hpp"
 #include "run/simulation.hpp"
 #include "scenario/scenario.hpp"
 #include "scene/input_error.hpp"
@@ -38,6 +39,17 @@ int run_command(const std::string& scenario_path, const std::string& engine, std
   return 0;
 }
 
+int resume_command(const std::string& path, const std::vector<std::string>& overrides, bool quiet) {
+  using namespace floedem;
+  const ResumeResult r = resume_run(path, overrides, !quiet);
+  if (!r.ran) {
+    if (!quiet) std::cout << r.message << "\n";
+    return 0;
+  }
+  if (!quiet) std::cout << "floedem run --resume: " << r.message << "\n" << format_summary(r.scene, r.summary, r.summary_output);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -49,7 +61,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   bool quiet = false;
   CLI::App* run = app.add_subcommand("run", "run a scenario on one engine and write its HDF5 output");
-  run->add_option("scenario", scenario, "scenario file (TOML), see scenarios/README.md")->required();
+  std::string resume;
+  CLI::Option* scenario_option =
+      run->add_option("scenario", scenario, "scenario file (TOML), see scenarios/README.md");
   std::string engine_names;
   for (const auto& e : floedem::engines()) engine_names += (engine_names.empty() ? "" : "|") + e.name;
   run->add_option("--engine,-e", engine, "engine: " + engine_names)->capture_default_str();
@@ -58,7 +72,19 @@ int main(int argc, char** argv) {
                   "override a scalar of the scenario, KEY=VALUE (e.g. run.duration=60, body[2].density=917); repeatable")
       ->allow_extra_args(false);
   run->add_flag("--quiet,-q", quiet, "no progress line and no summary");
-
+  CLI::Option* resume_option = run->add_option(
+      "--resume", resume,
+      "continue the run in RESULT.h5 (or RESULT.h5.partial, a run killed) from its last checkpoint, to the end of "
+      "its run.duration or of a longer one given with --set run.duration=T; the file ends as an uninterrupted "
+      "run's would (native engine; other engines run again from t = 0)");
+  resume_option->excludes(scenario_option);
+  run->get_option("--out")->excludes(resume_option);
+  run->get_option("--engine")->excludes(resume_option);
+  scenario_option->excludes(resume_option);
+  run->callback([&] {
+    if (scenario.empty() && resume.empty())
+      throw CLI::RequiredError("a scenario file, or --resume RESULT.h5,");
+  });
   CLI::App* list = app.add_subcommand("engines", "list the engines this build has");
 
   std::string report_out = "results/report";
@@ -100,7 +126,11 @@ int main(int argc, char** argv) {
       const int status = floedem::run_python_script("report.py", args);
       return status < 0 ? 1 : status;
     }
+    if (!resume.empty()) return resume_command(resume, overrides, quiet);
     return run_command(scenario, engine, output, overrides, quiet);
+  } catch (const floedem::StateError& e) {
+    std::cerr << "floedem: error: " << e.what() << "\n";
+    return 2;
   } catch (const floedem::InputError& e) {
     std::cerr << "floedem: error: " << e.what() << "\n";
     return 2;

@@ -169,4 +169,48 @@ void CollisionTracker::finish(const BodyStates& now, std::vector<CollisionRow>& 
   open_.clear();
 }
 
+void CollisionTracker::save(StateWriter& out) const {
+  // Field by field: no padding bytes reach the checkpoint (its bytes are part of the output).
+  out.tag("collisions");
+  out.value(step_);
+  out.value(static_cast<std::uint64_t>(open_.size()));
+  for (const auto& [key, e] : open_) {
+    const CollisionRow& r = e.row;
+    out.value(key.first);
+    out.value(key.second);
+    for (const double v : {r.time, r.normal_impulse, r.effective_mass, r.approach_speed, r.restitution_achieved,
+                           r.duration, r.mean_force, r.peak_force, e.peak_step_impulse})
+      out.value(v);
+    out.value(r.body_a);
+    out.value(r.body_b);
+    out.value(e.first_step);
+    out.value(e.last_step);
+    for (const Vec2 v : {e.normal, e.local_a, e.local_b}) out.value(v);
+  }
+}
+
+void CollisionTracker::restore(StateReader& in) {
+  in.tag("collisions");
+  in.value(step_);
+  const auto n = in.value<std::uint64_t>();
+  if (n > in.left()) throw StateError("checkpoint: truncated");
+  open_.clear();
+  for (std::uint64_t k = 0; k < n; ++k) {
+    PairKey key;
+    in.value(key.first);
+    in.value(key.second);
+    Event e;
+    CollisionRow& r = e.row;
+    for (double* v : {&r.time, &r.normal_impulse, &r.effective_mass, &r.approach_speed, &r.restitution_achieved,
+                      &r.duration, &r.mean_force, &r.peak_force, &e.peak_step_impulse})
+      in.value(*v);
+    in.value(r.body_a);
+    in.value(r.body_b);
+    in.value(e.first_step);
+    in.value(e.last_step);
+    for (Vec2* v : {&e.normal, &e.local_a, &e.local_b}) in.value(*v);
+    open_.emplace_hint(open_.end(), key, e);
+  }
+}
+
 }  // namespace floedem

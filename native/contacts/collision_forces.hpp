@@ -99,6 +99,9 @@ class CollisionTracker {
                std::vector<CollisionRow>& finished);
   /// At the end of the run: the events still open, in pair order.
   void finish(const BodyStates& now, std::vector<CollisionRow>& finished);
+  /// Checkpoint: the step count and the events still open.
+  void save(StateWriter& out) const;
+  void restore(StateReader& in);
 
  private:
   struct Event {

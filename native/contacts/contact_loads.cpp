@@ -35,4 +35,16 @@ const std::vector<Vec2>& ContactLoads::take_row() {
   return row_;
 }
 
+void ContactLoads::save(StateWriter& out) const {
+  out.tag("contact_loads");
+  out.vector(sum_);
+  out.value(steps_);
+}
+
+void ContactLoads::restore(StateReader& in) {
+  in.tag("contact_loads");
+  in.vector(sum_, bodies_.size(), "contact load sums");
+  in.value(steps_);
+}
+
 }  // namespace floedem

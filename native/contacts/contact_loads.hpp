@@ -22,6 +22,9 @@ class ContactLoads {
   void after_step(std::span<const ContactRecord> contacts);
   /// N, per listed body: the mean contact force over the steps since the last call.
   const std::vector<Vec2>& take_row();
+  /// Checkpoint: the sums of the row under way.
+  void save(StateWriter& out) const;
+  void restore(StateReader& in);
 
  private:
   std::vector<std::int32_t> bodies_;

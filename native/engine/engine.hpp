@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/state_io.hpp"
 #include "geometry/vec2.hpp"
 #include "scene/scene.hpp"
 
@@ -100,6 +101,14 @@ class Engine {
   /// The contact impulses of the last step.
   virtual std::span<const ContactRecord> contacts() const = 0;
   virtual EngineInfo info() const = 0;
+
+  /// Checkpoint and restart (floedem run --resume): writes everything the engine's next steps
+  /// depend on, so that restore_state() on an engine built from the same scene continues to
+  /// the bit. Returns false, writing nothing, for an engine that cannot: the reference engines
+  /// keep their contact caches inside libraries that neither expose nor accept them.
+  virtual bool save_state(StateWriter& /*out*/) const { return false; }
+  /// Reads what save_state() wrote (StateError when it does not fit this engine and scene).
+  virtual void restore_state(StateReader& /*in*/) { throw StateError("this engine cannot restore a checkpoint"); }
 };
 
 }  // namespace floedem

@@ -9,6 +9,9 @@
 #include <cstring>
 #include <filesystem>
 
+#include "engine/state_io.hpp"
+#include "scene/input_error.hpp"
+
 namespace floedem {
 
 namespace {
@@ -31,6 +34,26 @@ class Series {
     plist.setChunk(static_cast<int>(chunk.size()), chunk.data());
     H5Pset_obj_track_times(plist.getId(), false);  // no timestamps: identical runs, identical files
     dataset_ = parent.createDataSet(name, type_, space, plist);
+  }
+
+  /// An existing table (a resumed run), written with the memory type `type`.
+  Series(H5::DataSet dataset, const H5::DataType& type) : dataset_(std::move(dataset)), type_(type) {
+    const H5::DataSpace space = dataset_.getSpace();
+    std::vector<hsize_t> dims(static_cast<std::size_t>(space.getSimpleExtentNdims()));
+    space.getSimpleExtentDims(dims.data());
+    rows_ = dims.at(0);
+    row_shape_.assign(dims.begin() + 1, dims.end());
+  }
+
+  /// Cuts the table back to its first `rows` rows.
+  void truncate(hsize_t rows, const std::string& name) {
+    if (rows > rows_)
+      throw InputError(name + " has " + std::to_string(rows_) + " rows, fewer than the checkpoint's " +
+                       std::to_string(rows) + ": the file was changed after the run");
+    std::vector<hsize_t> dims{rows};
+    dims.insert(dims.end(), row_shape_.begin(), row_shape_.end());
+    if (H5Dset_extent(dataset_.getId(), dims.data()) < 0) throw H5::DataSetIException("truncate", name);
+    rows_ = rows;
   }
 
   void append(const void* data, hsize_t rows) {
@@ -79,6 +102,12 @@ void write_attribute(H5::H5Object& obj, const std::string& name, const std::stri
   a.write(type, value);
 }
 
+template <class T>
+void write_number_attribute(H5::H5Object& obj, const std::string& name, const H5::PredType& type, T value) {
+  H5::Attribute a = obj.attrExists(name) ? obj.openAttribute(name) : obj.createAttribute(name, type, H5::DataSpace(H5S_SCALAR));
+  a.write(type, &value);
+}
+
 void write_attribute(H5::H5Object& obj, const std::string& name, double value) {
   H5::Attribute a = obj.attrExists(name) ? obj.openAttribute(name)
                                           : obj.createAttribute(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(H5S_SCALAR));
@@ -99,6 +128,21 @@ std::string join(const std::vector<std::string>& v, const std::string& sep) {
   for (const auto& s : v) out += (out.empty() ? "" : sep) + s;
   return out;
 }
+
+/// Frames per chunk: about 64 K values, so that tiny scenes do not pay per-frame overhead.
+hsize_t frame_chunk_of(std::size_t bodies) {
+  const hsize_t per_frame = 2 * std::max<std::size_t>(bodies, 1);
+  return std::clamp<hsize_t>(65536 / per_frame, 1, 4096);
+}
+
+/// The checksum of a checkpoint slot: its bytes and its step (a slot whose step attribute
+/// was written without its bytes, or the reverse, fails it).
+std::uint64_t slot_checksum(std::int64_t step, const std::vector<std::uint8_t>& state) {
+  std::uint64_t h = state_checksum(state.data(), state.size());
+  return h ^ state_checksum(reinterpret_cast<const std::uint8_t*>(&step), sizeof step);
+}
+
+constexpr const char* kCheckpointSlots[2] = {"/checkpoint/slot_a", "/checkpoint/slot_b"};
 
 }  // namespace
 
@@ -214,14 +258,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     write_attribute(root, "status", "running");
     write_attribute(root, "engine", engine.name);
     write_attribute(root, "engine_version", engine.version);
-    write_attribute(root, "floedem_version", run.floedem_version);
-    write_attribute(root, "scenario", scene.source_text);
-    write_attribute(root, "scenario_path", scene.source_path);
-    write_attribute(root, "overrides", join(scene.overrides, "\n"));
-    write_attribute(root, "dt", scene.run.dt);
-    write_attribute(root, "duration", scene.run.duration);
-    write_attribute(root, "output_every", static_cast<double>(scene.run.output_every));
-    write_attribute(root, "forcing_terms", join(run.forcing_terms, ", "));
+    write_run_attributes(scene, run);
 
     H5::Group eng = d.file.createGroup("/engine");
     for (const auto& [k, v] : engine.settings) write_attribute(eng, k, v);
@@ -264,9 +301,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     write_fixed(bodies, "polygon_vertices", H5::PredType::NATIVE_DOUBLE, vertices, {vertices.size() / 2, 2});
     write_fixed(bodies, "polygon_offsets", H5::PredType::NATIVE_INT64, offsets, {n + 1});
 
-    // Frames: chunks of about 64 K values, so that tiny scenes do not pay per-frame overhead.
-    const hsize_t per_frame = 2 * std::max<std::size_t>(n, 1);
-    d.frame_chunk = std::clamp<hsize_t>(65536 / per_frame, 1, 4096);
+    d.frame_chunk = frame_chunk_of(n);
     d.time = Series(root, "time", H5::PredType::NATIVE_DOUBLE, {}, std::max<hsize_t>(d.frame_chunk, 256));
     d.position = Series(bodies, "position", H5::PredType::NATIVE_DOUBLE, {n, 2}, d.frame_chunk);
     d.angle = Series(bodies, "angle", H5::PredType::NATIVE_DOUBLE, {n}, d.frame_chunk);
@@ -339,6 +374,181 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     throw OutputError(partial_path_ + ": cannot create output file (" + e.getDetailMsg() +
                       "); is the directory there and writable?");
   }
+}
+
+void Recorder::write_run_attributes(const Scene& scene, const RunInfo& run) {
+  H5::Group root = impl_->file.openGroup("/");
+  write_attribute(root, "floedem_version", run.floedem_version);
+  write_attribute(root, "scenario", scene.source_text);
+  write_attribute(root, "scenario_path", scene.source_path);
+  write_attribute(root, "overrides", join(scene.overrides, "\n"));
+  write_attribute(root, "dt", scene.run.dt);
+  write_attribute(root, "duration", scene.run.duration);
+  write_attribute(root, "output_every", static_cast<double>(scene.run.output_every));
+  write_attribute(root, "forcing_terms", join(run.forcing_terms, ", "));
+}
+
+Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& run, const RecordedRows& rows)
+    : impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
+  namespace fs = std::filesystem;
+  H5::Exception::dontPrint();
+  // A finished run being continued is no longer complete: it goes back under .partial first.
+  if (!fs::exists(partial_path_)) {
+    std::error_code ec;
+    fs::rename(path_, partial_path_, ec);
+    if (ec) throw OutputError(path_ + ": cannot rename to " + partial_path_ + " to continue the run: " + ec.message());
+  }
+  check_space(scene);
+  Impl& d = *impl_;
+  try {
+    d.file = H5::H5File(partial_path_, H5F_ACC_RDWR);
+    H5::Group root = d.file.openGroup("/");
+    write_attribute(root, "status", "running");
+    std::vector<std::string> summary;
+    for (int k = 0; k < root.getNumAttrs(); ++k) {
+      const std::string name = root.openAttribute(static_cast<unsigned>(k)).getName();
+      if (name.rfind("summary_", 0) == 0) summary.push_back(name);
+    }
+    for (const std::string& name : summary) root.removeAttr(name);
+    write_run_attributes(scene, run);
+    d.bodies = scene.bodies.size();
+    d.frame_chunk = frame_chunk_of(d.bodies);
+    d.contact_output = scene.output.contacts;
+    auto open = [&](Series& s, const std::string& name, const H5::DataType& type, std::int64_t keep) {
+      s = Series(d.file.openDataSet(name), type);
+      s.truncate(static_cast<hsize_t>(keep), partial_path_ + ": " + name);
+    };
+    const H5::PredType& f64 = H5::PredType::NATIVE_DOUBLE;
+    const H5::PredType& i32 = H5::PredType::NATIVE_INT32;
+    open(d.time, "/time", f64, rows.frames);
+    open(d.position, "/bodies/position", f64, rows.frames);
+    open(d.angle, "/bodies/angle", f64, rows.frames);
+    open(d.velocity, "/bodies/velocity", f64, rows.frames);
+    open(d.angular_velocity, "/bodies/angular_velocity", f64, rows.frames);
+    const std::pair<Series*, const char*> contacts[] = {
+        {&d.c_time, "time"}, {&d.c_point, "point"}, {&d.c_normal, "normal"}, {&d.c_normal_impulse, "normal_impulse"},
+        {&d.c_tangent_impulse, "tangent_impulse"}, {&d.c_approach, "approach_velocity"}, {&d.c_separation, "separation"}};
+    for (const auto& [s, name] : contacts) open(*s, std::string("/contacts/") + name, f64, rows.contacts);
+    open(d.c_body_a, "/contacts/body_a", i32, rows.contacts);
+    open(d.c_body_b, "/contacts/body_b", i32, rows.contacts);
+    open(d.c_kind, "/contacts/kind", d.kind_type, rows.contacts);
+    const std::pair<Series*, const char*> events[] = {
+        {&d.e_time, "time"}, {&d.e_impulse, "normal_impulse"}, {&d.e_mass, "effective_mass"},
+        {&d.e_approach, "approach_speed"}, {&d.e_restitution, "restitution_achieved"}, {&d.e_duration, "duration"},
+        {&d.e_mean, "mean_force"}, {&d.e_peak, "peak_force"}};
+    for (const auto& [s, name] : events) open(*s, std::string("/contacts/collisions/") + name, f64, rows.collisions);
+    open(d.e_body_a, "/contacts/collisions/body_a", i32, rows.collisions);
+    open(d.e_body_b, "/contacts/collisions/body_b", i32, rows.collisions);
+    if (scene.tow.mode != TowSpec::Mode::none) {
+      d.tow = true;
+      for (const auto& [s, name] : {std::pair<Series*, const char*>{&d.tow_time, "time"}, {&d.tow_force, "force"},
+                                    {&d.tow_force_mean, "force_mean"}, {&d.tow_ice_mean, "ice_force_mean"},
+                                    {&d.tow_tug, "tug_position"}})
+        open(*s, std::string("/tow/") + name, f64, rows.tow);
+    }
+    if (!scene.output.load_bodies.empty()) {
+      open(d.load_time, "/loads/time", f64, rows.loads);
+      open(d.load_force, "/loads/force", f64, rows.loads);
+    }
+    d.flush();
+  } catch (const H5::Exception& e) {
+    throw OutputError(partial_path_ + ": cannot reopen the run's file to continue it (" + e.getDetailMsg() + ")");
+  }
+}
+
+void Recorder::write_checkpoint(std::int64_t index, std::int64_t step, const std::vector<std::uint8_t>& state) {
+  Impl& d = *impl_;
+  try {
+    d.write_buffers();
+    H5::Group group = d.file.nameExists("/checkpoint") ? d.file.openGroup("/checkpoint") : d.file.createGroup("/checkpoint");
+    const char* name = kCheckpointSlots[index % 2];
+    const hsize_t size = state.size();
+    if (!d.file.nameExists(name)) {
+      const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = 1 << 16;
+      H5::DataSpace space(1, &zero, &unlimited);
+      H5::DSetCreatPropList plist;
+      plist.setChunk(1, &chunk);
+      H5Pset_obj_track_times(plist.getId(), false);
+      d.file.createDataSet(name, H5::PredType::NATIVE_UINT8, space, plist);
+    }
+    H5::DataSet slot = d.file.openDataSet(name);
+    if (H5Dset_extent(slot.getId(), &size) < 0) throw H5::DataSetIException("set_extent", name);
+    if (size > 0) slot.write(state.data(), H5::PredType::NATIVE_UINT8);
+    write_number_attribute(slot, "step", H5::PredType::NATIVE_INT64, step);
+    write_number_attribute(slot, "checksum", H5::PredType::NATIVE_UINT64, slot_checksum(step, state));
+    d.file.flush(H5F_SCOPE_GLOBAL);
+  } catch (const H5::Exception& e) {
+    d.write_failed = true;
+    throw OutputError(partial_path_ + ": could not write a checkpoint (" + e.getDetailMsg() + "); disk full?");
+  }
+}
+
+RecordedRows Recorder::rows() const {
+  const Impl& d = *impl_;
+  return {frames(), contact_rows(), collision_rows(), static_cast<std::int64_t>(d.tow_time.rows() + d.w_time.size()),
+          static_cast<std::int64_t>(d.load_time.rows() + d.l_time.size())};
+}
+
+std::int64_t Recorder::frame_chunk() const { return static_cast<std::int64_t>(impl_->frame_chunk); }
+
+namespace {
+std::string read_string_attribute(const H5::H5Object& o, const std::string& name) {
+  if (!o.attrExists(name)) return {};
+  const H5::Attribute a = o.openAttribute(name);
+  std::string v;
+  a.read(a.getStrType(), v);
+  return v;
+}
+}  // namespace
+
+StoredRun read_stored_run(const std::string& path) {
+  H5::Exception::dontPrint();
+  if (!std::filesystem::exists(path)) throw InputError(path + ": no such file");
+  StoredRun run;
+  try {
+    if (!H5::H5File::isHdf5(path)) throw InputError(path + ": not an HDF5 file (a floedem run's output is)");
+    H5::H5File f(path, H5F_ACC_RDONLY);
+    const H5::Group root = f.openGroup("/");
+    run.engine = read_string_attribute(root, "engine");
+    run.scenario = read_string_attribute(root, "scenario");
+    if (run.engine.empty() || run.scenario.empty() || !f.nameExists("/bodies/mass"))
+      throw InputError(path + ": not a floedem run's output (no engine, scenario or /bodies/mass)");
+    run.status = read_string_attribute(root, "status");
+    run.floedem_version = read_string_attribute(root, "floedem_version");
+    run.scenario_path = read_string_attribute(root, "scenario_path");
+    if (root.attrExists("duration")) root.openAttribute("duration").read(H5::PredType::NATIVE_DOUBLE, &run.duration);
+    const std::string overrides = read_string_attribute(root, "overrides");
+    for (std::size_t at = 0; at < overrides.size();) {
+      const std::size_t end = std::min(overrides.find('\n', at), overrides.size());
+      if (end > at) run.overrides.push_back(overrides.substr(at, end - at));
+      at = end + 1;
+    }
+    H5::DataSet mass = f.openDataSet("/bodies/mass");
+    run.mass.resize(static_cast<std::size_t>(mass.getSpace().getSimpleExtentNpoints()));
+    if (!run.mass.empty()) mass.read(run.mass.data(), H5::PredType::NATIVE_DOUBLE);
+    for (const char* name : kCheckpointSlots) {
+      if (!f.nameExists("/checkpoint") || !f.nameExists(name)) continue;
+      H5::DataSet slot = f.openDataSet(name);
+      StoredCheckpoint c;
+      std::uint64_t checksum = 0;
+      if (!slot.attrExists("step") || !slot.attrExists("checksum")) {
+        ++run.damaged_slots;
+        continue;
+      }
+      slot.openAttribute("step").read(H5::PredType::NATIVE_INT64, &c.step);
+      slot.openAttribute("checksum").read(H5::PredType::NATIVE_UINT64, &checksum);
+      c.state.resize(static_cast<std::size_t>(slot.getSpace().getSimpleExtentNpoints()));
+      if (!c.state.empty()) slot.read(c.state.data(), H5::PredType::NATIVE_UINT8);
+      if (slot_checksum(c.step, c.state) != checksum) {
+        ++run.damaged_slots;
+        continue;
+      }
+      if (!run.checkpoint || c.step > run.checkpoint->step) run.checkpoint = std::move(c);
+    }
+  } catch (const H5::Exception& e) {
+    throw InputError(path + ": cannot read the run's file (" + e.getDetailMsg() + ")");
+  }
+  return run;
 }
 
 void Recorder::check_space(const Scene& scene) const {

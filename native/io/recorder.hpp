@@ -1,9 +1,12 @@
 #pragma once
 // HDF5 output of a run (layout in README.md, "Output"). Written as the run goes, under
 // RESULT.h5.partial, in chunks fixed by the data (so the bytes do not depend on the run's
-// speed), with HDF5 flushed at least once a second of wall time so that a killed run keeps
-// what it wrote readable; renamed to RESULT.h5 by finish() only.
+// speed), HDF5 flushed whenever a buffer is written, so that a killed run keeps what it wrote
+// readable; renamed to RESULT.h5 by finish() only. Checkpoints (/checkpoint, two slots
+// written in turn, each with its checksum) let `floedem run --resume` continue the run.
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -27,9 +30,39 @@ struct RunInfo {
   std::string floedem_version;
 };
 
+/// Rows of each growing table: what a checkpoint records, and what a resumed run cuts the
+/// file back to (rows written after the checkpoint are written again).
+struct RecordedRows {
+  std::int64_t frames = 0, contacts = 0, collisions = 0, tow = 0, loads = 0;
+};
+
+/// A checkpoint read back from a run's file: the newest of the two slots whose checksum holds.
+struct StoredCheckpoint {
+  std::int64_t step = 0;
+  std::vector<std::uint8_t> state;
+};
+
+/// What `floedem run --resume` needs from a run's file (root attributes and checkpoint).
+struct StoredRun {
+  std::string status, engine, floedem_version, scenario, scenario_path;
+  std::vector<std::string> overrides;
+  double duration = 0.0;     ///< s, run.duration of the run as written
+  std::vector<double> mass;  ///< /bodies/mass: the scene rebuilt must have the same bodies
+  std::optional<StoredCheckpoint> checkpoint;
+  int damaged_slots = 0;     ///< checkpoint slots with a wrong checksum (cut short by a kill)
+};
+
+/// Reads a run's file; InputError when it is missing or not a floedem run.
+StoredRun read_stored_run(const std::string& path);
+
 class Recorder {
  public:
   Recorder(const std::string& path, const Scene& scene, const EngineInfo& engine, const RunInfo& run);
+  /// Reopens `path`.partial (a run under way or killed; a finished run is renamed to it first)
+  /// to continue the run: the tables are cut back to `rows`, the status is "running" again,
+  /// the summary goes, and the run's attributes are rewritten for `scene` (its duration may
+  /// be longer than the first run's).
+  Recorder(const std::string& path, const Scene& scene, const RunInfo& run, const RecordedRows& rows);
   ~Recorder();
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
@@ -51,6 +84,15 @@ class Recorder {
   /// Writes what is buffered, marks the file complete, closes it and renames it to `path`.
   void finish(const std::vector<std::pair<std::string, double>>& summary);
 
+  /// Writes every buffered row, then `state` into checkpoint slot `index` % 2 with its step
+  /// and checksum, and flushes: the file then holds a whole checkpoint even if the process
+  /// is killed while the next one is written (the other slot).
+  void write_checkpoint(std::int64_t index, std::int64_t step, const std::vector<std::uint8_t>& state);
+  /// Rows so far, buffered included.
+  RecordedRows rows() const;
+  /// Frames per chunk of the frame tables (a checkpoint follows each full chunk).
+  std::int64_t frame_chunk() const;
+
   const std::string& partial_path() const { return partial_path_; }
   std::int64_t frames() const;
   std::int64_t contact_rows() const;
@@ -59,6 +101,7 @@ class Recorder {
  private:
   /// OutputError when the file system cannot hold the frames the scene will record.
   void check_space(const Scene& scene) const;
+  void write_run_attributes(const Scene& scene, const RunInfo& run);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::string path_;

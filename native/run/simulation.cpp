@@ -3,14 +3,18 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 #include "contacts/contact_loads.hpp"
 #include "io/recorder.hpp"
 #include "run/stepper.hpp"
+#include "scene/input_error.hpp"
 #include "version.hpp"
 
 namespace floedem {
@@ -39,13 +43,14 @@ bool finite_state(const BodyStates& s) {
 
 class Progress {
  public:
-  explicit Progress(bool enabled) : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1) {}
+  Progress(bool enabled, std::int64_t first_step)
+      : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1), first_(first_step) {}
   void update(std::int64_t step, std::int64_t steps) {
     if (!enabled_) return;
     const double elapsed = seconds_since(start_);
     if (elapsed < 1.0 || seconds_since(last_) < (tty_ ? 0.2 : 10.0)) return;
     last_ = clock::now();
-    const double left = elapsed * static_cast<double>(steps - step) / static_cast<double>(step);
+    const double left = elapsed * static_cast<double>(steps - step) / static_cast<double>(step - first_);
     std::fprintf(stderr, "%sstep %lld/%lld (%3.0f%%), %.1f s elapsed, ~%.1f s left%s", tty_ ? "\r" : "",
                  static_cast<long long>(step), static_cast<long long>(steps),
                  100.0 * static_cast<double>(step) / static_cast<double>(steps), elapsed, left, tty_ ? "" : "\n");
@@ -59,12 +64,72 @@ class Progress {
   using clock = std::chrono::steady_clock;
   static double seconds_since(clock::time_point t) { return std::chrono::duration<double>(clock::now() - t).count(); }
   bool enabled_, tty_;
+  std::int64_t first_;
   bool shown_ = false;
   clock::time_point start_ = clock::now();
   clock::time_point last_ = clock::now() - std::chrono::hours(1);
 };
 
+/// A test hook: FLOEDEM_TEST_KILL_AT_STEP=k makes the process kill itself (SIGKILL: no
+/// destructor runs, as when a job is killed) right after step k, so that a test of --resume
+/// can interrupt a run at a chosen place. 0 when unset.
+std::int64_t kill_at_step() {
+  const char* v = std::getenv("FLOEDEM_TEST_KILL_AT_STEP");
+  return v ? std::strtoll(v, nullptr, 10) : 0;
+}
+
+/// The checkpoint's layout; a file written with another one is refused on --resume.
+constexpr std::uint32_t kCheckpointFormat = 1;
+
+/// The driver's running figures: what run_scene carries from step to step besides the
+/// engine, the tow, the collision tracker and the contact loads.
+struct Tally {
+  RunSummary summary;
+  double overlap_sum = 0.0;
+  std::int64_t overlaps = 0;
+  std::int64_t checkpoints = 0;
+
+  void save(StateWriter& out) const {
+    out.tag("tally");
+    for (const std::int64_t v : {summary.collision_impulses, summary.resting_impulses, summary.collision_events, overlaps,
+                                 checkpoints})
+      out.value(v);
+    for (const double v : {summary.max_peak_force, summary.kinetic_energy_start, summary.max_speed_seen,
+                           summary.max_penetration, summary.max_kinetic_energy, overlap_sum})
+      out.value(v);
+  }
+  void restore(StateReader& in) {
+    in.tag("tally");
+    for (std::int64_t* v : {&summary.collision_impulses, &summary.resting_impulses, &summary.collision_events, &overlaps,
+                            &checkpoints})
+      in.value(*v);
+    for (double* v : {&summary.max_peak_force, &summary.kinetic_energy_start, &summary.max_speed_seen,
+                      &summary.max_penetration, &summary.max_kinetic_energy, &overlap_sum})
+      in.value(*v);
+  }
+};
+
+void save_rows(StateWriter& out, const RecordedRows& r) {
+  out.tag("rows");
+  for (const std::int64_t v : {r.frames, r.contacts, r.collisions, r.tow, r.loads}) out.value(v);
+}
+
+RecordedRows restore_rows(StateReader& in) {
+  RecordedRows r;
+  in.tag("rows");
+  for (std::int64_t* v : {&r.frames, &r.contacts, &r.collisions, &r.tow, &r.loads}) in.value(*v);
+  return r;
+}
+
 }  // namespace
+
+std::int64_t checkpoint_step(const std::vector<std::uint8_t>& state) {
+  StateReader in(state.data(), state.size());
+  in.tag("floedem checkpoint");
+  if (in.value<std::uint32_t>() != kCheckpointFormat)
+    throw StateError("checkpoint written by a floedem with another checkpoint layout");
+  return in.value<std::int64_t>();
+}
 
 RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -72,18 +137,48 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   RunInfo info;
   for (const auto name : stepper.forcing().names()) info.forcing_terms.emplace_back(name);
   info.floedem_version = kFloedemVersion;
-  Recorder recorder(options.output, scene, stepper.engine().info(), info);
-
-  RunSummary summary;
-  summary.engine = options.engine;
-  const std::int64_t steps = scene.run.steps();
-  summary.kinetic_energy_start = kinetic_energy(scene, stepper.state());
   TowMonitor& tow = stepper.tow();
   ContactLoads loads(scene);
-  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-  if (tow.active()) recorder.write_tow(0.0, {{nan, nan}, {nan, nan}, {nan, nan}, tow.tug_position(0.0)});  // no step yet
-  recorder.write_frame(0.0, stepper.state());
   CollisionTracker collisions(scene, duration_model_of(stepper.engine().info()));
+  Tally tally;
+  RunSummary& summary = tally.summary;
+  summary.engine = options.engine;
+  const std::int64_t steps = scene.run.steps();
+
+  // A fresh run, or one continued from its checkpoint: every part reads back its state, in
+  // the order of checkpoint() below, and the file is cut back to the rows written by then.
+  std::int64_t first = 1;
+  std::unique_ptr<Recorder> recorder_owner;
+  if (options.resume_state) {
+    const std::vector<std::uint8_t>& bytes = *options.resume_state;
+    StateReader in(bytes.data(), bytes.size());
+    const std::int64_t at = checkpoint_step(bytes);
+    in.tag("floedem checkpoint");
+    in.value<std::uint32_t>();
+    in.value<std::int64_t>();
+    if (at > steps)
+      throw InputError(scene.source_path + ": run.duration " + setting_text(scene.run.duration) +
+                       " s ends before the checkpoint (t = " + setting_text(static_cast<double>(at) * scene.run.dt) +
+                       " s) that the run continues from");
+    const RecordedRows rows = restore_rows(in);
+    tally.restore(in);
+    stepper.restore(in);
+    collisions.restore(in);
+    loads.restore(in);
+    if (in.left() != 0) throw StateError("checkpoint: more state than this run reads");
+    if (stepper.steps_done() != at) throw StateError("checkpoint: the engine's step count differs from the run's");
+    first = at + 1;
+    recorder_owner = std::make_unique<Recorder>(options.output, scene, info, rows);
+  } else {
+    recorder_owner = std::make_unique<Recorder>(options.output, scene, stepper.engine().info(), info);
+    summary.kinetic_energy_start = kinetic_energy(scene, stepper.state());
+    summary.max_kinetic_energy = summary.kinetic_energy_start;
+    constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+    if (tow.active()) recorder_owner->write_tow(0.0, {{nan, nan}, {nan, nan}, {nan, nan}, tow.tug_position(0.0)});  // no step yet
+    recorder_owner->write_frame(0.0, stepper.state());
+  }
+  Recorder& recorder = *recorder_owner;
+
   std::vector<CollisionRow> ended;
   auto record_collisions = [&] {
     for (const CollisionRow& r : ended) summary.max_peak_force = std::max(summary.max_peak_force, r.peak_force);
@@ -91,14 +186,35 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     recorder.write_collisions(ended);
     ended.clear();
   };
-  Progress progress(options.progress);
-  double overlap_sum = 0.0;
-  std::int64_t overlaps = 0;
+  // A checkpoint after each full chunk of frames (when the frames are written anyway): the
+  // state after step k and the rows written by then. Engines that cannot save their state
+  // get none (and --resume refuses their runs).
+  StateWriter checkpoint_bytes;
+  bool checkpoints = true;
+  auto checkpoint = [&](std::int64_t k) {
+    StateWriter& out = checkpoint_bytes;
+    out.clear();
+    out.tag("floedem checkpoint");
+    out.value(kCheckpointFormat);
+    out.value(k);
+    save_rows(out, recorder.rows());
+    ++tally.checkpoints;
+    tally.save(out);
+    if (!stepper.save(out)) {
+      checkpoints = false;
+      --tally.checkpoints;
+      return;
+    }
+    collisions.save(out);
+    loads.save(out);
+    recorder.write_checkpoint(tally.checkpoints - 1, k, out.bytes());
+  };
+  Progress progress(options.progress, first - 1);
   // Without forcing or towing nothing may add energy: the largest kinetic energy of the run is
   // then a check (recorded, summary_max_kinetic_energy); with forcing it is not, and not computed.
   const bool track_energy = stepper.forcing().names().empty() && !tow.active();
-  summary.max_kinetic_energy = summary.kinetic_energy_start;
-  for (std::int64_t k = 1; k <= steps; ++k) {
+  const std::int64_t kill_at = kill_at_step();
+  for (std::int64_t k = first; k <= steps; ++k) {
     stepper.step();
     const double t_end = stepper.time();
     const BodyStates& state = stepper.state();
@@ -110,8 +226,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
       ++(c.kind == ContactKind::collision ? summary.collision_impulses : summary.resting_impulses);
       if (c.separation < 0.0) {
         summary.max_penetration = std::max(summary.max_penetration, -c.separation);
-        overlap_sum -= c.separation;
-        ++overlaps;
+        tally.overlap_sum -= c.separation;
+        ++tally.overlaps;
       }
     }
     // Stability figures for the stress suite: cheap (one pass over the bodies).
@@ -120,22 +236,33 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     recorder.write_contacts(t_end, contacts);
     collisions.observe(t_end, contacts, state, ended);
     if (!ended.empty()) record_collisions();
-    if (tow.active() && (k % scene.tow_every() == 0 || k == steps)) recorder.write_tow(t_end, tow.take_frame(t_end));
+    // Rows on their cadence here; the last step's rows off the cadence after the loop, so
+    // that a checkpoint is the same whether the run ends there or goes on (--resume with a
+    // longer run.duration).
+    if (tow.active() && k % scene.tow_every() == 0) recorder.write_tow(t_end, tow.take_frame(t_end));
     if (loads.active()) {
       loads.after_step(contacts);
-      if (k % scene.load_every() == 0 || k == steps) recorder.write_loads(t_end, loads.take_row());
+      if (k % scene.load_every() == 0) recorder.write_loads(t_end, loads.take_row());
     }
-    if (k % scene.run.output_every == 0 || k == steps) recorder.write_frame(t_end, state);
+    if (k % scene.run.output_every == 0) {
+      recorder.write_frame(t_end, state);
+      if (checkpoints && recorder.frames() % recorder.frame_chunk() == 0) checkpoint(k);
+    }
     progress.update(k, steps);
+    if (k == kill_at) std::raise(SIGKILL);
   }
   progress.done();
-  collisions.finish(stepper.state(), ended);
-  record_collisions();
   const BodyStates& state = stepper.state();
+  const double t_end = stepper.time();
+  if (tow.active() && steps % scene.tow_every() != 0) recorder.write_tow(t_end, tow.take_frame(t_end));
+  if (loads.active() && steps % scene.load_every() != 0) recorder.write_loads(t_end, loads.take_row());
+  if (steps % scene.run.output_every != 0) recorder.write_frame(t_end, state);
+  collisions.finish(state, ended);
+  record_collisions();
   summary.steps = steps;
   summary.kinetic_energy_end = kinetic_energy(scene, state);
   summary.max_speed_seen = std::sqrt(summary.max_speed_seen);
-  summary.mean_penetration = overlaps > 0 ? overlap_sum / static_cast<double>(overlaps) : 0.0;
+  summary.mean_penetration = tally.overlaps > 0 ? tally.overlap_sum / static_cast<double>(tally.overlaps) : 0.0;
   if (!track_energy) summary.max_kinetic_energy = std::numeric_limits<double>::quiet_NaN();
   for (const Vec2 v : state.velocity) summary.max_speed = std::max(summary.max_speed, length(v));
   summary.frames = recorder.frames();

@@ -6,6 +6,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "scene/scene.hpp"
 
@@ -21,6 +22,9 @@ struct RunOptions {
   std::string engine = "native";
   std::string output;          ///< RESULT.h5
   bool progress = false;       ///< progress line on stderr for runs longer than a second
+  /// Continue from this checkpoint (read_stored_run) instead of starting: output must be the
+  /// run's file, which is cut back to the checkpoint and extended (resume.hpp).
+  const std::vector<std::uint8_t>* resume_state = nullptr;
 };
 
 struct RunSummary {
@@ -45,6 +49,10 @@ struct RunSummary {
 /// Runs the scene and writes its output; throws InputError (bad engine settings, before any
 /// file is made), OutputError, SolverFailure.
 RunSummary run_scene(const Scene& scene, const RunOptions& options);
+
+/// The step a checkpoint was taken after (StateError when it is not a checkpoint this
+/// floedem can read).
+std::int64_t checkpoint_step(const std::vector<std::uint8_t>& state);
 
 /// Multi-line human summary.
 std::string format_summary(const Scene& scene, const RunSummary& s, const std::string& output);

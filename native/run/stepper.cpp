@@ -15,4 +15,25 @@ void Stepper::step() {
   ++steps_;
 }
 
+bool Stepper::save(StateWriter& out) const {
+  StateWriter engine;
+  if (!engine_->save_state(engine)) return false;
+  out.tag("stepper");
+  out.value(steps_);
+  out.vector(engine.bytes());
+  tow_.save(out);
+  return true;
+}
+
+void Stepper::restore(StateReader& in) {
+  in.tag("stepper");
+  in.value(steps_);
+  std::vector<std::uint8_t> engine;
+  in.vector(engine);
+  StateReader engine_in(engine.data(), engine.size());
+  engine_->restore_state(engine_in);
+  if (engine_in.left() != 0) throw StateError("checkpoint: the engine's state is longer than the engine reads");
+  tow_.restore(in);
+}
+
 }  // namespace floedem

@@ -32,6 +32,11 @@ class Stepper {
   TowMonitor& tow() { return tow_; }
   const TowMonitor& tow() const { return tow_; }
 
+  /// Checkpoint: the step count, the engine's state and the tow's (the forcing holds none
+  /// between steps). False, writing nothing, when the engine cannot save its state.
+  bool save(StateWriter& out) const;
+  void restore(StateReader& in);
+
  private:
   const Scene& scene_;
   double dt_;

@@ -31,6 +31,8 @@ class NativeEngine final : public Engine {
   const BodyStates& state() const override { return bodies_; }
   std::span<const ContactRecord> contacts() const override { return records_; }
   EngineInfo info() const override;
+  bool save_state(StateWriter& out) const override;
+  void restore_state(StateReader& in) override;
 
  private:
   void find_pairs(const Loads* loads);
@@ -118,6 +120,70 @@ EngineInfo NativeEngine::info() const {
       {"broad_phase_refreshed_parts", std::to_string(pair_cache_.refreshed_parts())},
   };
   return i;
+}
+
+bool NativeEngine::save_state(StateWriter& out) const {
+  // What the next steps read: the bodies (the rotation too, so that no sin/cos is redone),
+  // last step's manifolds (warm start and persistence: pair, feature id, impulses, kind),
+  // the broad phase's cache, and the counts info() reports. Everything else is rebuilt from
+  // these (placed parts, boxes, reach) or is scratch.
+  out.tag("native");
+  out.vector(bodies_.position);
+  out.vector(bodies_.angle);
+  out.vector(bodies_.rotation);
+  out.vector(bodies_.velocity);
+  out.vector(bodies_.angular_velocity);
+  out.value(static_cast<std::uint64_t>(manifolds_.size()));
+  for (const Manifold& m : manifolds_) {
+    out.value(m.part_a);
+    out.value(m.part_b);
+    out.value(static_cast<std::int32_t>(m.point_count));
+    for (int k = 0; k < m.point_count; ++k) {
+      out.value(m.points[k].id);
+      out.value(m.points[k].normal_impulse);
+      out.value(m.points[k].tangent_impulse);
+      out.value(m.points[k].kind);
+    }
+  }
+  pair_cache_.save(out);
+  out.value(total_sweeps_);
+  out.value(steps_);
+  out.value(cold_restarts_);
+  return true;
+}
+
+void NativeEngine::restore_state(StateReader& in) {
+  in.tag("native");
+  const std::size_t n = bodies_.position.size();
+  in.vector(bodies_.position, n, "body positions");
+  in.vector(bodies_.angle, n, "body angles");
+  in.vector(bodies_.rotation, n, "body rotations");
+  in.vector(bodies_.velocity, n, "body velocities");
+  in.vector(bodies_.angular_velocity, n, "body angular velocities");
+  const auto count = in.value<std::uint64_t>();
+  if (count > in.left()) throw StateError("checkpoint: truncated");
+  manifolds_.assign(static_cast<std::size_t>(count), Manifold{});
+  const auto parts = static_cast<std::int32_t>(parts_.size());
+  for (Manifold& m : manifolds_) {
+    in.value(m.part_a);
+    in.value(m.part_b);
+    m.point_count = in.value<std::int32_t>();
+    if (m.part_a < 0 || m.part_a >= m.part_b || m.part_b >= parts || m.point_count < 1 || m.point_count > 2)
+      throw StateError("checkpoint: a contact manifold that does not fit this scene");
+    m.body_a = parts_.body()[m.part_a];
+    m.body_b = parts_.body()[m.part_b];
+    for (int k = 0; k < m.point_count; ++k) {
+      in.value(m.points[k].id);
+      in.value(m.points[k].normal_impulse);
+      in.value(m.points[k].tangent_impulse);
+      in.value(m.points[k].kind);
+    }
+  }
+  pair_cache_.restore(in, parts_.body(), parts_.immovable());
+  in.value(total_sweeps_);
+  in.value(steps_);
+  in.value(cold_restarts_);
+  records_.clear();  // the contacts of the step before the checkpoint are not needed again
 }
 
 void NativeEngine::step(const Loads* loads) {

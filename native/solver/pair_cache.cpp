@@ -89,4 +89,33 @@ void PairCache::refresh(std::span<const std::int32_t> body, std::span<const std:
   for (const std::int32_t k : moved_list_) moved_[k] = 0;
 }
 
+void PairCache::save(StateWriter& out) const {
+  out.tag("pair_cache");
+  out.vector(fat_);
+  out.vector(stale_list_);
+  out.vector(candidates_);
+  out.value(rebuilds_);
+  out.value(refreshed_);
+}
+
+void PairCache::restore(StateReader& in, std::span<const std::int32_t> body, std::span<const std::uint8_t> fixed) {
+  in.tag("pair_cache");
+  in.vector(fat_);
+  if (!fat_.empty() && fat_.size() != body.size()) throw StateError("checkpoint: the broad phase has another number of parts");
+  in.vector(stale_list_);
+  in.vector(candidates_);
+  in.value(rebuilds_);
+  in.value(refreshed_);
+  const std::size_t n = fat_.size();
+  stale_.assign(n, 0);
+  moved_.assign(n, 0);
+  for (const std::int32_t k : stale_list_) {
+    if (k < 0 || static_cast<std::size_t>(k) >= n) throw StateError("checkpoint: broad phase part out of range");
+    stale_[k] = 1;
+  }
+  for (const PartPair& p : candidates_)
+    if (p.a < 0 || p.b < 0 || static_cast<std::size_t>(p.b) >= n) throw StateError("checkpoint: broad phase pair out of range");
+  if (n > 0) grid_.find_pairs(fat_, body, fixed, fresh_);  // the grid only; its pairs are not used
+}
+
 }  // namespace floedem

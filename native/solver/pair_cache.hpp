@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "engine/state_io.hpp"
 #include "solver/broad_phase.hpp"
 
 namespace floedem {
@@ -27,6 +28,14 @@ class PairCache {
 
   std::int64_t rebuilds() const { return rebuilds_; }
   std::int64_t refreshed_parts() const { return refreshed_; }  ///< parts given a new fat box, over the run
+
+  /// Checkpoint: the fat boxes, which of them the grid holds old, the candidates and the
+  /// counts. Restoring rebuilds the grid over the present fat boxes: a stale part's entry
+  /// then differs from the one it replaces, but stale parts are never taken from the grid
+  /// (refresh() tests them directly), so every later step finds the same pairs and rebuilds
+  /// at the same steps as the run that was not interrupted.
+  void save(StateWriter& out) const;
+  void restore(StateReader& in, std::span<const std::int32_t> body, std::span<const std::uint8_t> fixed);
 
  private:
   void rebuild(std::span<const std::int32_t> body, std::span<const std::uint8_t> fixed);

@@ -53,6 +53,20 @@ void TowMonitor::after_step(std::span<const ContactRecord> contacts, const std::
   ++count_;
 }
 
+void TowMonitor::save(StateWriter& out) const {
+  out.tag("tow");
+  for (const Vec2 v : {force_, ice_, sum_, ice_sum_}) out.value(v);
+  out.value(count_);
+  out.value(time_);
+}
+
+void TowMonitor::restore(StateReader& in) {
+  in.tag("tow");
+  for (Vec2* v : {&force_, &ice_, &sum_, &ice_sum_}) in.value(*v);
+  in.value(count_);
+  in.value(time_);  // the rope is found again at the start of the next step
+}
+
 TowFrame TowMonitor::take_frame(double time) {
   TowFrame f;
   f.force = force_;

@@ -46,6 +46,9 @@ class TowMonitor {
   Vec2 tug_position(double time) const;        ///< m (rope: the tug; velocity: the body's path)
   /// The frame at `time`: means over the steps since the last call (frames every k-th step).
   TowFrame take_frame(double time);
+  /// Checkpoint: the last step's forces and the sums of the frame under way.
+  void save(StateWriter& out) const;
+  void restore(StateReader& in);
 
  private:
   const Scene& scene_;

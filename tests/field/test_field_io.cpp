@@ -20,13 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path dir_for(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("floedem-field-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 FieldSpec small_spec() {
   FieldSpec s;
   s.width = 300.0;
@@ -43,7 +36,7 @@ FieldSpec small_spec() {
 }  // namespace
 
 TEST_CASE("field file: the /bodies layout of a run, read back by the run reader", "[field][io]") {
-  const fs::path d = dir_for("file");
+  const fs::path d = test::temp_dir("field-file");
   const FieldSpec s = small_spec();
   const Field f = generate_field(s);
   const std::string path = (d / "f.h5").string();
@@ -105,7 +98,7 @@ TEST_CASE("scenario [field]: generated around the scenario's bodies, or loaded f
   CHECK(achieved->second == Approx(ice / free_area).epsilon(1e-9));
 
   // The same floes through a field file: `file` reads them back in the same order.
-  const fs::path d = dir_for("scenario");
+  const fs::path d = test::temp_dir("field-scenario");
   FieldSpec s = small_spec();
   s.d_max = 30.0;
   const Field generated = generate_field(s);
@@ -150,7 +143,7 @@ TEST_CASE("scenario [field]: bad keys are refused with file, field and range", "
 
 TEST_CASE("cli: floedem field writes a field file, and bad input exits 2 naming the flag and writes nothing",
           "[field][cli]") {
-  const fs::path d = dir_for("cli");
+  const fs::path d = test::temp_dir("field-cli");
   const std::string common = " --width 200 --height 150 --alpha 2 --dmin 3 --dmax 30 --thickness 1.16 --seed 3";
   const test::CliResult good = test::run_cli("field" + common + " --concentration 0.5 --out " + (d / "f.h5").string());
   INFO(good.output);

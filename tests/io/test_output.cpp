@@ -31,13 +31,6 @@ std::string string_attribute(const H5::H5Object& o, const std::string& name) {
   return v;
 }
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("floedem-test-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 const std::string kScene = test::header_toml(1.0, 0.01, 0.3, 0.3, "[engine.native]\nvelocity_iterations = 20\n") +
                            test::body_toml({"a", test::box({5, 5}, 10, 10), {1.0, 0.0}}) +
                            test::body_toml({"b", {{10.5, 0}, {20.5, 0}, {10.5, 12}}, {}, 0.1});
@@ -45,7 +38,7 @@ const std::string kScene = test::header_toml(1.0, 0.01, 0.3, 0.3, "[engine.nativ
 }  // namespace
 
 TEST_CASE("output layout: bodies, frames, contacts, attributes", "[output]") {
-  const fs::path dir = temp_dir("layout");
+  const fs::path dir = test::temp_dir("layout");
   const std::string out = (dir / "r.h5").string();
   Scene s = test::scene_from(kScene, {"run.output_every=10"});
   RunOptions o;
@@ -111,7 +104,7 @@ TEST_CASE("output layout: bodies, frames, contacts, attributes", "[output]") {
 }
 
 TEST_CASE("a run killed mid-way leaves a readable .partial and no final file", "[output]") {
-  const fs::path dir = temp_dir("killed");
+  const fs::path dir = test::temp_dir("killed");
   const fs::path scenario = dir / "long.toml";
   std::ofstream(scenario) << test::header_toml(1e7, 0.01, 0.3, 0.3) +
                                  test::body_toml({"a", test::box({5, 5}, 10, 10), {1.0, 0.0}}) +

@@ -1,0 +1,352 @@
+// Checkpoint and restart: a run killed mid-way and continued with `floedem run --resume`
+// ends with the file of a run never interrupted, every dataset and attribute to the bit.
+#include <catch2/catch.hpp>
+
+#include <hdf5.h>
+#include <H5Cpp.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "engine/registry.hpp"
+#include "io/recorder.hpp"
+#include "run/stepper.hpp"
+#include "support.hpp"
+
+using namespace floedem;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Everything in a file, object by object: each dataset's shape and values and each
+/// attribute's value, as bytes (variable-length strings as their text).
+using Contents = std::map<std::string, std::string>;
+
+std::string read_values(hid_t obj, hid_t type, hid_t space, bool attribute) {
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(std::max(rank, 0)));
+  if (rank > 0) H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  std::string out = "shape";
+  for (const hsize_t d : dims) out += " " + std::to_string(d);
+  out += ":";
+  if (H5Tis_variable_str(type) > 0) {
+    std::vector<char*> strings(static_cast<std::size_t>(n));
+    hid_t mem = H5Tcopy(H5T_C_S1);
+    H5Tset_size(mem, H5T_VARIABLE);
+    H5Tset_cset(mem, H5Tget_cset(type));
+    if (attribute)
+      H5Aread(obj, mem, strings.data());
+    else
+      H5Dread(obj, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, strings.data());
+    for (char* s : strings) out += std::string(s ? s : "") + '\0';
+    H5Dvlen_reclaim(mem, space, H5P_DEFAULT, strings.data());
+    H5Tclose(mem);
+    return out;
+  }
+  std::string bytes(static_cast<std::size_t>(n) * H5Tget_size(type), '\0');
+  if (!bytes.empty()) {
+    if (attribute)
+      H5Aread(obj, type, bytes.data());
+    else
+      H5Dread(obj, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, bytes.data());
+  }
+  return out + bytes;
+}
+
+herr_t read_attribute(hid_t obj, const char* name, const H5A_info_t*, void* data) {
+  auto& [contents, path] = *static_cast<std::pair<Contents*, std::string>*>(data);
+  const hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
+  const hid_t type = H5Aget_type(a), space = H5Aget_space(a);
+  (*contents)[path + "@" + name] = read_values(a, type, space, true);
+  H5Sclose(space);
+  H5Tclose(type);
+  H5Aclose(a);
+  return 0;
+}
+
+herr_t read_object(hid_t file, const char* name, const H5O_info_t* info, void* data) {
+  auto* contents = static_cast<Contents*>(data);
+  const hid_t obj = H5Oopen(file, name, H5P_DEFAULT);
+  const std::string path = std::string(name) == "." ? "/" : "/" + std::string(name);
+  std::pair<Contents*, std::string> at{contents, path};
+  H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, nullptr, read_attribute, &at);
+  if (info->type == H5O_TYPE_DATASET) {
+    const hid_t type = H5Dget_type(obj), space = H5Dget_space(obj);
+    (*contents)[path] = read_values(obj, type, space, false);
+    H5Sclose(space);
+    H5Tclose(type);
+  } else {
+    (*contents)[path] = "group";
+  }
+  H5Oclose(obj);
+  return 0;
+}
+
+Contents contents(const fs::path& file) {
+  Contents out;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  REQUIRE(f >= 0);
+  H5Ovisit(f, H5_INDEX_NAME, H5_ITER_INC, read_object, &out);
+  H5Fclose(f);
+  return out;
+}
+
+/// The names of the objects and attributes that differ (both ways).
+std::vector<std::string> differences(const Contents& a, const Contents& b) {
+  std::vector<std::string> out;
+  for (const auto& [k, v] : a) {
+    const auto it = b.find(k);
+    if (it == b.end() || it->second != v) out.push_back(k);
+  }
+  for (const auto& [k, v] : b)
+    if (!a.count(k)) out.push_back(k);
+  return out;
+}
+
+/// An iceberg on a rope through a generated field of ~300 floes, drifting in wind and current
+/// with Coriolis and waves, every output on: the state of every part of a run (rope,
+/// collisions under way, contact loads, warm-started manifolds, the broad phase's cache)
+/// must come back from a checkpoint. Frames every 2nd step: a checkpoint about every 100 steps.
+const std::string kScenario = R"(
+[run]
+duration = 60.0
+dt = 0.05
+output_every = 2
+seed = 5
+[contact]
+restitution = 0.2
+friction = 0.3
+[output]
+contacts = "all"
+loads = ["iceberg"]
+load_every = 7
+tow_every = 3
+[environment]
+current = [0.2, 0.05]
+wind = [6.0, -2.0]
+latitude = 70.0
+[environment.waves]
+amplitude = 0.5
+period = 8.0
+direction = 30.0
+[[body]]
+name = "iceberg"
+kind = "iceberg"
+polygon = [[-30, -20], [25, -25], [30, 15], [-5, 28], [-28, 10]]
+draft = 40.0
+sail_height = 10.0
+[tow]
+mode = "rope"
+body = "iceberg"
+tug_velocity = [0.8, 0.1]
+stiffness = 2e5
+length = 60.0
+damping = 1e4
+[field]
+origin = [-150.0, -120.0]
+width = 300.0
+height = 240.0
+concentration = 0.6
+alpha = 2.0
+d_min = 6.0
+d_max = 30.0
+thickness = 1.0
+velocity = [0.1, 0.0]
+)";
+
+/// Checks that `file` holds what `expected` does, naming the first object that differs.
+void check_same_contents(const Contents& expected, const fs::path& file) {
+  const auto diff = differences(expected, contents(file));
+  INFO("differing: " << (diff.empty() ? std::string() : diff.front()));
+  CHECK(diff.empty());
+}
+
+struct Files {
+  fs::path dir, scenario;
+};
+
+Files write_scenario(const std::string& name, const std::string& text = kScenario) {
+  Files f{test::temp_dir("resume-" + name), {}};
+  f.scenario = f.dir / "towed.toml";
+  std::ofstream(f.scenario) << text;
+  return f;
+}
+
+std::string run_args(const Files& f, const std::string& out, const std::string& extra = "") {
+  return "run " + f.scenario.string() + " -q --out " + (f.dir / out).string() + " " + extra;
+}
+
+}  // namespace
+
+TEST_CASE("resume: a run killed mid-way and continued gives the uninterrupted run's file", "[resume]") {
+  const Files f = write_scenario("killed");
+  REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+  REQUIRE(whole.count("/checkpoint/slot_a"));
+  REQUIRE(whole.count("/checkpoint/slot_b"));
+  REQUIRE(whole.count("/tow/force"));
+  REQUIRE(whole.count("/loads/force"));
+
+  // Killed (SIGKILL, no destructor runs) after step 777 of 1200, between two checkpoints.
+  const auto killed = test::run_cli(run_args(f, "cut.h5"), "FLOEDEM_TEST_KILL_AT_STEP=777 ");
+  CHECK(killed.code != 0);
+  CHECK_FALSE(fs::exists(f.dir / "cut.h5"));
+  REQUIRE(fs::exists(f.dir / "cut.h5.partial"));
+  const StoredRun stored = read_stored_run((f.dir / "cut.h5.partial").string());
+  CHECK(stored.status == "running");
+  REQUIRE(stored.checkpoint);
+  CHECK(stored.checkpoint->step < 777);
+  CHECK(stored.checkpoint->step > 500);
+
+  // Continued: by its final name (the .partial is found) or by the .partial's own name.
+  const std::string target = GENERATE(std::string("cut.h5"), std::string("cut.h5.partial"));
+  INFO("--resume " << target);
+  const auto resumed = test::run_cli("run --resume " + (f.dir / target).string());
+  INFO(resumed.output);
+  REQUIRE(resumed.code == 0);
+  CHECK(resumed.output.find("continued from the checkpoint at t = ") != std::string::npos);
+  CHECK_FALSE(fs::exists(f.dir / "cut.h5.partial"));
+  REQUIRE(fs::exists(f.dir / "cut.h5"));
+  check_same_contents(whole, f.dir / "cut.h5");
+  fs::remove_all(f.dir);
+}
+
+TEST_CASE("resume: killed twice, and a damaged checkpoint falls back to the other slot", "[resume]") {
+  const Files f = write_scenario("twice");
+  REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+
+  REQUIRE(test::run_cli(run_args(f, "cut.h5"), "FLOEDEM_TEST_KILL_AT_STEP=450 ").code != 0);
+  // The continuation is killed too, further on.
+  REQUIRE(test::run_cli("run --resume " + (f.dir / "cut.h5").string() + " -q", "FLOEDEM_TEST_KILL_AT_STEP=900 ").code != 0);
+  const fs::path partial = f.dir / "cut.h5.partial";
+  const StoredRun before = read_stored_run(partial.string());
+  REQUIRE(before.checkpoint);
+  CHECK(before.checkpoint->step > 700);
+  CHECK(before.damaged_slots == 0);
+  {
+    // A kill while a checkpoint was written: one byte of the newest slot changed.
+    H5::H5File file(partial.string(), H5F_ACC_RDWR);
+    for (const char* name : {"/checkpoint/slot_a", "/checkpoint/slot_b"}) {
+      H5::DataSet slot = file.openDataSet(name);
+      std::int64_t step = 0;
+      slot.openAttribute("step").read(H5::PredType::NATIVE_INT64, &step);
+      if (step != before.checkpoint->step) continue;
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(slot.getSpace().getSimpleExtentNpoints()));
+      slot.read(bytes.data(), H5::PredType::NATIVE_UINT8);
+      bytes[bytes.size() / 2] ^= 0x10;
+      slot.write(bytes.data(), H5::PredType::NATIVE_UINT8);
+    }
+  }
+  const StoredRun damaged = read_stored_run(partial.string());
+  CHECK(damaged.damaged_slots == 1);
+  REQUIRE(damaged.checkpoint);
+  CHECK(damaged.checkpoint->step < before.checkpoint->step);
+
+  REQUIRE(test::run_cli("run --resume " + (f.dir / "cut.h5").string() + " -q").code == 0);
+  check_same_contents(whole, f.dir / "cut.h5");
+  fs::remove_all(f.dir);
+}
+
+TEST_CASE("resume: a finished run lengthened with run.duration is the longer run", "[resume]") {
+  const Files f = write_scenario("longer");
+  // The longer run made at once, and the same made as a 30 s run continued to 60 s.
+  REQUIRE(test::run_cli(run_args(f, "whole.h5", "--set run.duration=60")).code == 0);
+  REQUIRE(test::run_cli(run_args(f, "short.h5", "--set run.duration=30.05")).code == 0);
+  const auto same = test::run_cli("run --resume " + (f.dir / "short.h5").string());
+  CHECK(same.code == 0);
+  CHECK(same.output.find("the run is complete") != std::string::npos);
+  const auto longer = test::run_cli("run --resume " + (f.dir / "short.h5").string() + " -q --set run.duration=60");
+  INFO(longer.output);
+  REQUIRE(longer.code == 0);
+  check_same_contents(contents(f.dir / "whole.h5"), f.dir / "short.h5");
+  fs::remove_all(f.dir);
+}
+
+TEST_CASE("resume: an engine without checkpoints runs again from the start, to the same file", "[resume]") {
+  const Files f = write_scenario("box2d");
+  REQUIRE(test::run_cli(run_args(f, "whole.h5", "-e box2d --set run.duration=10")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+  CHECK_FALSE(whole.count("/checkpoint"));
+  REQUIRE(test::run_cli(run_args(f, "cut.h5", "-e box2d --set run.duration=10"), "FLOEDEM_TEST_KILL_AT_STEP=150 ").code != 0);
+  const auto resumed = test::run_cli("run --resume " + (f.dir / "cut.h5").string());
+  INFO(resumed.output);
+  REQUIRE(resumed.code == 0);
+  CHECK(resumed.output.find("the box2d engine cannot save its state") != std::string::npos);
+  check_same_contents(whole, f.dir / "cut.h5");
+  fs::remove_all(f.dir);
+}
+
+TEST_CASE("resume: bad input is refused with the file and the reason, exit 2, nothing changed", "[resume][bad-input]") {
+  const Files f = write_scenario("bad");
+  REQUIRE(test::run_cli(run_args(f, "r.h5", "--set run.duration=20")).code == 0);
+  const fs::path r = f.dir / "r.h5";
+  const auto missing = test::run_cli("run --resume " + (f.dir / "none.h5").string());
+  CHECK(missing.code == 2);
+  CHECK(missing.output.find("none.h5: no such run output") != std::string::npos);
+  const auto not_hdf5 = test::run_cli("run --resume " + f.scenario.string());
+  CHECK(not_hdf5.code == 2);
+  CHECK(not_hdf5.output.find("not an HDF5 file") != std::string::npos);
+  const auto other_key = test::run_cli("run --resume " + r.string() + " --set run.dt=0.1");
+  CHECK(other_key.code == 2);
+  CHECK(other_key.output.find("only run.duration may be set") != std::string::npos);
+  const auto shorter = test::run_cli("run --resume " + r.string() + " --set run.duration=1");
+  CHECK(shorter.code == 2);
+  CHECK(shorter.output.find("before the checkpoint") != std::string::npos);
+  CHECK(test::run_cli("run --resume " + r.string() + " -e box2d").code == 2);
+  CHECK(test::run_cli("run " + f.scenario.string() + " --resume " + r.string()).code == 2);
+  // Refused requests leave the run's file as it was.
+  CHECK(fs::exists(r));
+  CHECK_FALSE(fs::exists(r.string() + ".partial"));
+  CHECK(read_stored_run(r.string()).status == "complete");
+  fs::remove_all(f.dir);
+}
+
+TEST_CASE("resume: the native engine restored from its state steps on to the bit", "[resume]") {
+  // A jam: many resting contacts carried over by warm start, the broad phase's cache in use.
+  std::string text = test::header_toml(1.0, 0.05, 0.1, 0.3, "[environment]\ncurrent = [-0.6, 0.1]\n");
+  text += test::body_toml({"wall", test::box({-2, 50}, 4, 120), {}, 0.0, true});
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 10; ++j)
+      text += test::body_toml({"f" + std::to_string(i) + "_" + std::to_string(j),
+                               test::box({6.0 + 11.5 * i, 5.0 + 11.5 * j}, 9.0, 9.5, 0.02 * (i - j)), {-0.3, 0.0}});
+  const Scene s = test::scene_from(text);
+  Stepper a(s, "native");
+  for (int k = 0; k < 1200; ++k) a.step();
+  REQUIRE(a.contacts().size() > 50);
+  StateWriter saved;
+  REQUIRE(a.save(saved));
+  Stepper b(s, "native");
+  StateReader in(saved.bytes().data(), saved.bytes().size());
+  b.restore(in);
+  CHECK(in.left() == 0);
+  CHECK(b.steps_done() == 1200);
+  for (int k = 0; k < 200; ++k) {
+    a.step();
+    b.step();
+  }
+  const BodyStates& x = a.state();
+  const BodyStates& y = b.state();
+  bool identical = true;
+  for (std::size_t i = 0; i < x.position.size(); ++i)
+    identical = identical && x.position[i].x == y.position[i].x && x.position[i].y == y.position[i].y &&
+                x.angle[i] == y.angle[i] && x.velocity[i].x == y.velocity[i].x &&
+                x.angular_velocity[i] == y.angular_velocity[i];
+  CHECK(identical);
+  CHECK(a.engine().info().settings == b.engine().info().settings);  // sweeps, restarts, broad-phase counts
+  // Another scene's state is refused, not read as garbage.
+  const Scene other = test::scene_from(test::header_toml(1.0, 0.05, 0.1, 0.3) + test::body_toml({"a", test::box({0, 0}, 5, 5)}));
+  Stepper c(other, "native");
+  StateReader wrong(saved.bytes().data(), saved.bytes().size());
+  CHECK_THROWS_AS(c.restore(wrong), StateError);
+  // A reference engine has no state to save.
+  Stepper d(s, "box2d");
+  StateWriter none;
+  CHECK_FALSE(d.save(none));
+  CHECK(none.bytes().empty());
+}
