@@ -13,6 +13,7 @@
 
 #include "contacts/contact_loads.hpp"
 #include "io/recorder.hpp"
+#include "run/energy_balance.hpp"
 #include "run/stepper.hpp"
 #include "scene/input_error.hpp"
 #include "version.hpp"
@@ -140,6 +141,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   TowMonitor& tow = stepper.tow();
   ContactLoads loads(scene);
   CollisionTracker collisions(scene, duration_model_of(stepper.engine().info()));
+  EnergyBalance energy(scene);
   Tally tally;
   RunSummary& summary = tally.summary;
   summary.engine = options.engine;
@@ -165,6 +167,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     stepper.restore(in);
     collisions.restore(in);
     loads.restore(in);
+    energy.restore(in);
     if (in.left() != 0) throw StateError("checkpoint: more state than this run reads");
     if (stepper.steps_done() != at) throw StateError("checkpoint: the engine's step count differs from the run's");
     first = at + 1;
@@ -207,6 +210,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     }
     collisions.save(out);
     loads.save(out);
+    energy.save(out);
     recorder.write_checkpoint(tally.checkpoints - 1, k, out.bytes());
   };
   Progress progress(options.progress, first - 1);
@@ -215,6 +219,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const bool track_energy = stepper.forcing().names().empty() && !tow.active();
   const std::int64_t kill_at = kill_at_step();
   for (std::int64_t k = first; k <= steps; ++k) {
+    energy.before_step(stepper.state());
     stepper.step();
     const double t_end = stepper.time();
     const BodyStates& state = stepper.state();
@@ -222,6 +227,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
       throw SolverFailure("non-finite body state at step " + std::to_string(k) + " (t = " + std::to_string(t_end) +
                           " s); output so far kept in " + recorder.partial_path());
     const auto contacts = stepper.contacts();
+    energy.after_step(stepper.last_loads(), state, contacts);
     for (const ContactRecord& c : contacts) {
       ++(c.kind == ContactKind::collision ? summary.collision_impulses : summary.resting_impulses);
       if (c.separation < 0.0) {
@@ -265,6 +271,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   summary.mean_penetration = tally.overlaps > 0 ? tally.overlap_sum / static_cast<double>(tally.overlaps) : 0.0;
   if (!track_energy) summary.max_kinetic_energy = std::numeric_limits<double>::quiet_NaN();
   for (const Vec2 v : state.velocity) summary.max_speed = std::max(summary.max_speed, length(v));
+  summary.work_of_loads = energy.work_of_loads();
+  summary.work_of_paths = energy.work_of_paths();
+  summary.contact_work = energy.contact_work();
+  summary.max_relative_energy_gain = energy.max_relative_gain();
   summary.frames = recorder.frames();
   summary.contact_rows = recorder.contact_rows();
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -279,7 +289,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                    {"max_speed", summary.max_speed_seen},
                    {"max_penetration", summary.max_penetration},
                    {"mean_penetration", summary.mean_penetration},
-                   {"max_kinetic_energy", summary.max_kinetic_energy}});
+                   {"max_kinetic_energy", summary.max_kinetic_energy},
+                   {"work_of_loads", summary.work_of_loads},
+                   {"work_of_paths", summary.work_of_paths},
+                   {"contact_work", summary.contact_work},
+                   {"max_relative_energy_gain", summary.max_relative_energy_gain}});
   // No wall time in the file: two runs of one scene give bit-identical files.
   return summary;
 }

@@ -43,6 +43,13 @@ struct RunSummary {
   double max_penetration = 0.0;       ///< m, deepest overlap at the start of a step, any contact
   double mean_penetration = 0.0;      ///< m, mean overlap over the contact points that overlap
   double max_kinetic_energy = 0.0;    ///< J, largest kinetic energy after any step
+  // Energy balance of the moving bodies (run/energy_balance.hpp), J: the work of the
+  // non-contact loads, of bodies on a prescribed path through contacts, and the contacts' own
+  // (<= 0); the largest relative gain of a step (0 for a sound solver, up to rounding).
+  double work_of_loads = 0.0;
+  double work_of_paths = 0.0;
+  double contact_work = 0.0;
+  double max_relative_energy_gain = 0.0;
   double wall_seconds = 0.0;
 };
 

@@ -10,7 +10,8 @@ Stepper::Stepper(const Scene& scene, const std::string& engine)
 void Stepper::step() {
   const double start = time();
   if (tow_.active()) tow_.before_step(engine_->state(), start);
-  engine_->step(forcing_.evaluate(engine_->state(), start));
+  loads_ = forcing_.evaluate(engine_->state(), start);
+  engine_->step(loads_);
   if (tow_.active()) tow_.after_step(engine_->contacts(), forcing_.environment_force(scene_.tow.body));
   ++steps_;
 }

@@ -29,6 +29,8 @@ class Stepper {
   const BodyStates& state() const { return engine_->state(); }
   std::span<const ContactRecord> contacts() const { return engine_->contacts(); }
   const Forcing& forcing() const { return forcing_; }
+  /// The loads of the last step (nullptr: none), valid until the next step.
+  const Loads* last_loads() const { return loads_; }
   TowMonitor& tow() { return tow_; }
   const TowMonitor& tow() const { return tow_; }
 
@@ -44,6 +46,7 @@ class Stepper {
   Forcing forcing_;
   TowMonitor tow_;
   std::int64_t steps_ = 0;
+  const Loads* loads_ = nullptr;
 };
 
 }  // namespace floedem

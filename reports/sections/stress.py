@@ -1,14 +1,20 @@
 """Numerical stability under stress (issue 9): scenarios/stress/ on every engine, and the
 stability map. A run "holds" when it finishes (no NaN or infinity: floedem exits 4 on one),
 its deepest penetration stays below 1 % of the thinnest floe's thickness, no body moves faster
-than the case allows, no body ends up beyond a wall (tunnelling), and, without forcing, the
+than the case allows, no body ends up beyond a wall (tunnelling), the contacts make no energy
+(the energy balance, native/run/energy_balance.hpp: the kinetic energy change less the work of
+the loads and of a towed body is the contacts' work, which must not be positive, net over the
+run or by more than 1e-6 of the energy in play in any one step), and, without forcing, the
 kinetic energy never rises above its start (summary attributes of each run: max_penetration,
-max_speed, max_kinetic_energy; the last frame for the walls).
+max_speed, contact_work, max_relative_energy_gain, max_kinetic_energy; the last frame for the
+walls).
 
 Why these bounds: 1 % of the thickness is the issue's bound (a floe 0.11 m thick may overlap
 its neighbour by 1.1 mm); the speed bounds are what momentum allows (a floe struck by a body of
 speed V leaves at most at (1 + e) V, so 2 V is a generous bound for the unforced cases; wind
-and current drive floes at a few per cent of the wind, so 2 m/s bounds the jam)."""
+and current drive floes at a few per cent of the wind, so 2 m/s bounds the jam). 1e-6 of a
+step's energy: far above rounding (1e-13 for sums over 1e5 bodies), and a gain that, repeated,
+would add 1 % over 10^4 steps; inelastic contacts and friction only ever take energy away."""
 import math
 import os
 
@@ -20,6 +26,7 @@ from report_runner import Run
 MASSES = [1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10]   # kg, iceberg: ratios 1e2..1e8 to the 99 kg floes
 FLOE_MASS = 0.11 * 900.0                         # kg, the mass_ratio floes
 PENETRATION_FRACTION = 0.01
+STEP_GAIN = 1e-6                                 # largest energy a step's contacts may make, of the energy in play
 ITERATIONS_LADDER = 5000                         # native's velocity iterations for the second ladder
 # Where the moving bodies must stay (x_min, x_max, y_min, y_max; m): in front of the wall whose
 # face is x = 0 (mass_ratio, slivers), inside the walled bay (jam). A centroid beyond is a body
@@ -105,6 +112,8 @@ class Outcome:
             self.speed = float(a["summary_max_speed"])
             self.energy_ratio = float(a["summary_max_kinetic_energy"] / a["summary_kinetic_energy_start"]) \
                 if m["unforced"] and a["summary_kinetic_energy_start"] > 0 else math.nan
+            self.contact_work = float(a["summary_contact_work"])
+            self.step_gain = float(a["summary_max_relative_energy_gain"])
             self.wall = run.seconds
             self.escaped = 0
             if "inside" in m:
@@ -130,6 +139,10 @@ class Outcome:
             self.reasons.append(f"{self.escaped} bodies through a wall")
         if m["unforced"] and self.energy_ratio > 1.0 + 1e-6:
             self.reasons.append(f"energy gain x{self.energy_ratio:.6g}")
+        if self.contact_work > 0.0:
+            self.reasons.append(f"contacts made {self.contact_work:.3g} J net")
+        if not self.step_gain <= STEP_GAIN:
+            self.reasons.append(f"a step's contacts made {self.step_gain:.2g} of its energy")
 
     @property
     def holds(self):
@@ -150,7 +163,9 @@ def write(ctx):
           "`scenarios/stress/` on every engine (issue 9). A run holds when it finishes without a non-finite state, its "
           f"deepest penetration stays below {PENETRATION_FRACTION:.0%} of the thinnest floe's thickness, no body moves "
           "faster than momentum allows (2 V for a body struck at V; 2 m/s under wind and current), none is pushed "
-          "through a wall (its centroid beyond the wall's face at the end), and without "
+          "through a wall (its centroid beyond the wall's face at the end), the contacts make no energy (the kinetic "
+          "energy change less the work of the loads and of a towed body is the contacts' work: not positive over the "
+          f"run, nor above {STEP_GAIN:g} of the energy in play in any step), and without "
           "forcing the kinetic energy never exceeds its start (figures from each run's `summary_*` attributes). "
           "Cells: yes (with the deepest penetration), or no and why.", "",
           "![stability map](fig/stability_map.png)", "",
