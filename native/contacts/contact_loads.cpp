@@ -6,7 +6,7 @@ Vec2 contact_impulse_on(std::int32_t body, std::span<const ContactRecord> contac
   Vec2 impulse;
   for (const ContactRecord& c : contacts) {
     if (c.body_a != body && c.body_b != body) continue;
-    const Vec2 p = c.normal_impulse * c.normal + c.tangent_impulse * perp(c.normal);
+    const Vec2 p = c.impulse();
     if (c.body_b == body) impulse += p;
     if (c.body_a == body) impulse -= p;
   }

@@ -69,6 +69,8 @@ struct ContactRecord {
   double approach_velocity = 0.0;  ///< m/s, normal relative velocity before the step (< 0 approaching)
   double separation = 0.0;         ///< m, signed gap at the start of the step (< 0 overlapping)
   ContactKind kind = ContactKind::resting;
+  /// N s, the impulse on body_b (on body_a its opposite).
+  Vec2 impulse() const { return normal_impulse * normal + tangent_impulse * perp(normal); }
 };
 
 /// A real-valued setting or figure as text for EngineInfo: 15 significant digits, so that

@@ -43,6 +43,9 @@ class StateWriter {
     raw(v.data(), v.size() * sizeof(T));
   }
   const std::vector<std::uint8_t>& bytes() const { return bytes_; }
+  std::size_t size() const { return bytes_.size(); }
+  /// Drops what was written after the first `size` bytes.
+  void truncate(std::size_t size) { bytes_.resize(std::min(size, bytes_.size())); }
   void clear() { bytes_.clear(); }
 
  private:

@@ -109,9 +109,7 @@ void write_number_attribute(H5::H5Object& obj, const std::string& name, const H5
 }
 
 void write_attribute(H5::H5Object& obj, const std::string& name, double value) {
-  H5::Attribute a = obj.attrExists(name) ? obj.openAttribute(name)
-                                          : obj.createAttribute(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(H5S_SCALAR));
-  a.write(H5::PredType::NATIVE_DOUBLE, &value);
+  write_number_attribute(obj, name, H5::PredType::NATIVE_DOUBLE, value);
 }
 
 H5::EnumType contact_kind_type() {
@@ -174,6 +172,67 @@ struct Recorder::Impl {
   std::vector<double> l_time, l_force;
   bool closed = false;
   bool write_failed = false;
+
+  /// A growing table: where it lives, the type it is written with, its row shape, rows per
+  /// chunk, and the count of RecordedRows that says how many rows it has.
+  struct Table {
+    Series* series;
+    const char* path;
+    H5::DataType type;
+    std::vector<hsize_t> row_shape;
+    hsize_t chunk;
+    std::int64_t RecordedRows::*rows;
+  };
+
+  /// Every growing table of the scene's file, in one list for creating them (a new run) and for
+  /// reopening and cutting them back (a resumed run). frame_chunk and tow must be set.
+  std::vector<Table> tables(const Scene& scene) {
+    const H5::PredType& f64 = H5::PredType::NATIVE_DOUBLE;
+    const H5::PredType& i32 = H5::PredType::NATIVE_INT32;
+    const hsize_t n = bodies;
+    constexpr hsize_t kc = 4096, ke = 1024, kt = 1024;  // /tow and /loads may be written every step
+    using R = RecordedRows;
+    std::vector<Table> t = {
+        {&time, "/time", f64, {}, std::max<hsize_t>(frame_chunk, 256), &R::frames},
+        {&position, "/bodies/position", f64, {n, 2}, frame_chunk, &R::frames},
+        {&angle, "/bodies/angle", f64, {n}, frame_chunk, &R::frames},
+        {&velocity, "/bodies/velocity", f64, {n, 2}, frame_chunk, &R::frames},
+        {&angular_velocity, "/bodies/angular_velocity", f64, {n}, frame_chunk, &R::frames},
+        {&c_time, "/contacts/time", f64, {}, kc, &R::contacts},
+        {&c_body_a, "/contacts/body_a", i32, {}, kc, &R::contacts},
+        {&c_body_b, "/contacts/body_b", i32, {}, kc, &R::contacts},
+        {&c_point, "/contacts/point", f64, {2}, kc, &R::contacts},
+        {&c_normal, "/contacts/normal", f64, {2}, kc, &R::contacts},
+        {&c_normal_impulse, "/contacts/normal_impulse", f64, {}, kc, &R::contacts},
+        {&c_tangent_impulse, "/contacts/tangent_impulse", f64, {}, kc, &R::contacts},
+        {&c_approach, "/contacts/approach_velocity", f64, {}, kc, &R::contacts},
+        {&c_separation, "/contacts/separation", f64, {}, kc, &R::contacts},
+        {&c_kind, "/contacts/kind", kind_type, {}, kc, &R::contacts},
+        {&e_time, "/contacts/collisions/time", f64, {}, ke, &R::collisions},
+        {&e_body_a, "/contacts/collisions/body_a", i32, {}, ke, &R::collisions},
+        {&e_body_b, "/contacts/collisions/body_b", i32, {}, ke, &R::collisions},
+        {&e_impulse, "/contacts/collisions/normal_impulse", f64, {}, ke, &R::collisions},
+        {&e_mass, "/contacts/collisions/effective_mass", f64, {}, ke, &R::collisions},
+        {&e_approach, "/contacts/collisions/approach_speed", f64, {}, ke, &R::collisions},
+        {&e_restitution, "/contacts/collisions/restitution_achieved", f64, {}, ke, &R::collisions},
+        {&e_duration, "/contacts/collisions/duration", f64, {}, ke, &R::collisions},
+        {&e_mean, "/contacts/collisions/mean_force", f64, {}, ke, &R::collisions},
+        {&e_peak, "/contacts/collisions/peak_force", f64, {}, ke, &R::collisions},
+    };
+    if (tow) {
+      t.push_back({&tow_time, "/tow/time", f64, {}, kt, &R::tow});
+      t.push_back({&tow_force, "/tow/force", f64, {2}, kt, &R::tow});
+      t.push_back({&tow_force_mean, "/tow/force_mean", f64, {2}, kt, &R::tow});
+      t.push_back({&tow_ice_mean, "/tow/ice_force_mean", f64, {2}, kt, &R::tow});
+      t.push_back({&tow_tug, "/tow/tug_position", f64, {2}, kt, &R::tow});
+    }
+    if (!scene.output.load_bodies.empty()) {
+      const hsize_t nb = scene.output.load_bodies.size();
+      t.push_back({&load_time, "/loads/time", f64, {}, kt, &R::loads});
+      t.push_back({&load_force, "/loads/force", f64, {nb, 2}, kt, &R::loads});
+    }
+    return t;
+  }
 
   void write_buffers() {
     if (buffered_frames > 0) {
@@ -301,67 +360,28 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     write_fixed(bodies, "polygon_vertices", H5::PredType::NATIVE_DOUBLE, vertices, {vertices.size() / 2, 2});
     write_fixed(bodies, "polygon_offsets", H5::PredType::NATIVE_INT64, offsets, {n + 1});
 
-    d.frame_chunk = frame_chunk_of(n);
-    d.time = Series(root, "time", H5::PredType::NATIVE_DOUBLE, {}, std::max<hsize_t>(d.frame_chunk, 256));
-    d.position = Series(bodies, "position", H5::PredType::NATIVE_DOUBLE, {n, 2}, d.frame_chunk);
-    d.angle = Series(bodies, "angle", H5::PredType::NATIVE_DOUBLE, {n}, d.frame_chunk);
-    d.velocity = Series(bodies, "velocity", H5::PredType::NATIVE_DOUBLE, {n, 2}, d.frame_chunk);
-    d.angular_velocity = Series(bodies, "angular_velocity", H5::PredType::NATIVE_DOUBLE, {n}, d.frame_chunk);
-
     H5::Group contacts = d.file.createGroup("/contacts");
     const char* which = scene.output.contacts == ContactOutput::all ? "all"
                         : scene.output.contacts == ContactOutput::collisions ? "collisions" : "none";
     write_attribute(contacts, "recorded", which);
-    constexpr hsize_t kc = 4096;
-    d.c_time = Series(contacts, "time", H5::PredType::NATIVE_DOUBLE, {}, kc);
-    d.c_body_a = Series(contacts, "body_a", H5::PredType::NATIVE_INT32, {}, kc);
-    d.c_body_b = Series(contacts, "body_b", H5::PredType::NATIVE_INT32, {}, kc);
-    d.c_point = Series(contacts, "point", H5::PredType::NATIVE_DOUBLE, {2}, kc);
-    d.c_normal = Series(contacts, "normal", H5::PredType::NATIVE_DOUBLE, {2}, kc);
-    d.c_normal_impulse = Series(contacts, "normal_impulse", H5::PredType::NATIVE_DOUBLE, {}, kc);
-    d.c_tangent_impulse = Series(contacts, "tangent_impulse", H5::PredType::NATIVE_DOUBLE, {}, kc);
-    d.c_approach = Series(contacts, "approach_velocity", H5::PredType::NATIVE_DOUBLE, {}, kc);
-    d.c_separation = Series(contacts, "separation", H5::PredType::NATIVE_DOUBLE, {}, kc);
-    d.c_kind = Series(contacts, "kind", d.kind_type, {}, kc);
     d.contact_output = scene.output.contacts;
-    {
-      H5::Group events = d.file.createGroup("/contacts/collisions");
-      write_attribute(events, "duration_coefficient", scene.contact.duration_coefficient);
-      write_attribute(events, "duration_model", describe(duration_model_of(engine)));
-      constexpr hsize_t ke = 1024;
-      d.e_time = Series(events, "time", H5::PredType::NATIVE_DOUBLE, {}, ke);
-      d.e_body_a = Series(events, "body_a", H5::PredType::NATIVE_INT32, {}, ke);
-      d.e_body_b = Series(events, "body_b", H5::PredType::NATIVE_INT32, {}, ke);
-      d.e_impulse = Series(events, "normal_impulse", H5::PredType::NATIVE_DOUBLE, {}, ke);
-      d.e_mass = Series(events, "effective_mass", H5::PredType::NATIVE_DOUBLE, {}, ke);
-      d.e_approach = Series(events, "approach_speed", H5::PredType::NATIVE_DOUBLE, {}, ke);
-      d.e_restitution = Series(events, "restitution_achieved", H5::PredType::NATIVE_DOUBLE, {}, ke);
-      d.e_duration = Series(events, "duration", H5::PredType::NATIVE_DOUBLE, {}, ke);
-      d.e_mean = Series(events, "mean_force", H5::PredType::NATIVE_DOUBLE, {}, ke);
-      d.e_peak = Series(events, "peak_force", H5::PredType::NATIVE_DOUBLE, {}, ke);
-    }
-
+    H5::Group events = d.file.createGroup("/contacts/collisions");
+    write_attribute(events, "duration_coefficient", scene.contact.duration_coefficient);
+    write_attribute(events, "duration_model", describe(duration_model_of(engine)));
     if (scene.tow.mode != TowSpec::Mode::none) {
       d.tow = true;
       H5::Group tow = d.file.createGroup("/tow");
       write_attribute(tow, "mode", scene.tow.mode == TowSpec::Mode::velocity ? "velocity" : "rope");
       write_attribute(tow, "body", scene.bodies[scene.tow.body].name);
-      constexpr hsize_t kt = 1024;  // rows per chunk: /tow may be written every step
-      d.tow_time = Series(tow, "time", H5::PredType::NATIVE_DOUBLE, {}, kt);
-      d.tow_force = Series(tow, "force", H5::PredType::NATIVE_DOUBLE, {2}, kt);
-      d.tow_force_mean = Series(tow, "force_mean", H5::PredType::NATIVE_DOUBLE, {2}, kt);
-      d.tow_ice_mean = Series(tow, "ice_force_mean", H5::PredType::NATIVE_DOUBLE, {2}, kt);
-      d.tow_tug = Series(tow, "tug_position", H5::PredType::NATIVE_DOUBLE, {2}, kt);
     }
     if (!scene.output.load_bodies.empty()) {
       H5::Group loads = d.file.createGroup("/loads");
-      const hsize_t nb = scene.output.load_bodies.size();
       std::vector<std::int32_t> load_ids;
       for (const std::size_t i : scene.output.load_bodies) load_ids.push_back(static_cast<std::int32_t>(i));
-      write_fixed(loads, "body", H5::PredType::NATIVE_INT32, load_ids, {nb});
-      d.load_time = Series(loads, "time", H5::PredType::NATIVE_DOUBLE, {}, 1024);
-      d.load_force = Series(loads, "force", H5::PredType::NATIVE_DOUBLE, {nb, 2}, 1024);
+      write_fixed(loads, "body", H5::PredType::NATIVE_INT32, load_ids, {load_ids.size()});
     }
+    d.frame_chunk = frame_chunk_of(n);
+    for (const Impl::Table& t : d.tables(scene)) *t.series = Series(root, t.path, t.type, t.row_shape, t.chunk);
     for (const Provenance& p : scene.provenance) {
       H5::Group g = d.file.createGroup(p.group);
       for (const auto& [k, v] : p.text) write_attribute(g, k, v);
@@ -414,41 +434,10 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& r
     d.bodies = scene.bodies.size();
     d.frame_chunk = frame_chunk_of(d.bodies);
     d.contact_output = scene.output.contacts;
-    auto open = [&](Series& s, const std::string& name, const H5::DataType& type, std::int64_t keep) {
-      s = Series(d.file.openDataSet(name), type);
-      s.truncate(static_cast<hsize_t>(keep), partial_path_ + ": " + name);
-    };
-    const H5::PredType& f64 = H5::PredType::NATIVE_DOUBLE;
-    const H5::PredType& i32 = H5::PredType::NATIVE_INT32;
-    open(d.time, "/time", f64, rows.frames);
-    open(d.position, "/bodies/position", f64, rows.frames);
-    open(d.angle, "/bodies/angle", f64, rows.frames);
-    open(d.velocity, "/bodies/velocity", f64, rows.frames);
-    open(d.angular_velocity, "/bodies/angular_velocity", f64, rows.frames);
-    const std::pair<Series*, const char*> contacts[] = {
-        {&d.c_time, "time"}, {&d.c_point, "point"}, {&d.c_normal, "normal"}, {&d.c_normal_impulse, "normal_impulse"},
-        {&d.c_tangent_impulse, "tangent_impulse"}, {&d.c_approach, "approach_velocity"}, {&d.c_separation, "separation"}};
-    for (const auto& [s, name] : contacts) open(*s, std::string("/contacts/") + name, f64, rows.contacts);
-    open(d.c_body_a, "/contacts/body_a", i32, rows.contacts);
-    open(d.c_body_b, "/contacts/body_b", i32, rows.contacts);
-    open(d.c_kind, "/contacts/kind", d.kind_type, rows.contacts);
-    const std::pair<Series*, const char*> events[] = {
-        {&d.e_time, "time"}, {&d.e_impulse, "normal_impulse"}, {&d.e_mass, "effective_mass"},
-        {&d.e_approach, "approach_speed"}, {&d.e_restitution, "restitution_achieved"}, {&d.e_duration, "duration"},
-        {&d.e_mean, "mean_force"}, {&d.e_peak, "peak_force"}};
-    for (const auto& [s, name] : events) open(*s, std::string("/contacts/collisions/") + name, f64, rows.collisions);
-    open(d.e_body_a, "/contacts/collisions/body_a", i32, rows.collisions);
-    open(d.e_body_b, "/contacts/collisions/body_b", i32, rows.collisions);
-    if (scene.tow.mode != TowSpec::Mode::none) {
-      d.tow = true;
-      for (const auto& [s, name] : {std::pair<Series*, const char*>{&d.tow_time, "time"}, {&d.tow_force, "force"},
-                                    {&d.tow_force_mean, "force_mean"}, {&d.tow_ice_mean, "ice_force_mean"},
-                                    {&d.tow_tug, "tug_position"}})
-        open(*s, std::string("/tow/") + name, f64, rows.tow);
-    }
-    if (!scene.output.load_bodies.empty()) {
-      open(d.load_time, "/loads/time", f64, rows.loads);
-      open(d.load_force, "/loads/force", f64, rows.loads);
+    d.tow = scene.tow.mode != TowSpec::Mode::none;
+    for (const Impl::Table& t : d.tables(scene)) {
+      *t.series = Series(d.file.openDataSet(t.path), t.type);
+      t.series->truncate(static_cast<hsize_t>(rows.*t.rows), partial_path_ + ": " + t.path);
     }
     d.flush();
   } catch (const H5::Exception& e) {

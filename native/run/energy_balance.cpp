@@ -39,10 +39,11 @@ void EnergyBalance::before_step(const BodyStates& state) {
     w_star_[i] = state.angular_velocity[i];
   }
   for (const std::size_t i : on_path_) path_position_[i] = state.position[i];
-  ke_before_ = kinetic_energy(v_star_, w_star_);
+  if (!ke_before_known_) ke_before_ = kinetic_energy(v_star_, w_star_);
 }
 
 void EnergyBalance::after_step(const Loads* loads, const BodyStates& after, std::span<const ContactRecord> contacts) {
+  const double ke_start = ke_before_;
   // v*: the velocities the loads alone give (a Coriolis turn first, as the engines do).
   if (loads && !loads->velocity_turn.empty())
     for (const std::size_t i : moving_) v_star_[i] = loads->velocity_turn[i].apply(v_star_[i]);
@@ -57,7 +58,7 @@ void EnergyBalance::after_step(const Loads* loads, const BodyStates& after, std:
     for (const ContactRecord& c : contacts) {
       const bool a_path = path_body_[c.body_a] != 0, b_path = path_body_[c.body_b] != 0;
       if (!a_path && !b_path) continue;
-      const Vec2 on_b = c.normal_impulse * c.normal + c.tangent_impulse * Vec2{-c.normal.y, c.normal.x};
+      const Vec2 on_b = c.impulse();
       auto point_velocity = [&](std::int32_t k) {
         return after.velocity[k] + cross(after.angular_velocity[k], c.point - path_position_[k]);
       };
@@ -67,7 +68,9 @@ void EnergyBalance::after_step(const Loads* loads, const BodyStates& after, std:
   }
   const double ke_after = kinetic_energy(after.velocity, after.angular_velocity);
   const double contact = ke_after - ke_star - path_work;
-  work_loads_ += ke_star - ke_before_;
+  ke_before_ = ke_after;  // the next step starts from this state
+  ke_before_known_ = true;
+  work_loads_ += ke_star - ke_start;
   work_path_ += path_work;
   work_contact_ += contact;
   const double scale = ke_star + std::abs(path_work);

@@ -28,7 +28,8 @@ namespace floedem {
 class EnergyBalance {
  public:
   explicit EnergyBalance(const Scene& scene);
-  /// Before the step: the velocities it starts from.
+  /// Before the step: the velocities it starts from (the state the last after_step saw, as
+  /// the driver steps: its kinetic energy is then not summed again).
   void before_step(const BodyStates& state);
   /// After it: the loads it was given (nullptr: none), the state and the contacts.
   void after_step(const Loads* loads, const BodyStates& after, std::span<const ContactRecord> contacts);
@@ -55,7 +56,8 @@ class EnergyBalance {
   std::vector<Vec2> v_star_;
   std::vector<double> w_star_;
   std::vector<Vec2> path_position_;     // per body on a path: its centroid at the step's start
-  double ke_before_ = 0.0;
+  double ke_before_ = 0.0;       // KE(v_n); after a step, that of the state it ended in
+  bool ke_before_known_ = false;  // so before_step need not sum it again
   double work_loads_ = 0.0, work_path_ = 0.0, work_contact_ = 0.0, max_gain_ = 0.0;
 };
 

@@ -74,14 +74,9 @@ ResumeResult resume_run(const std::string& path, const std::vector<std::string>&
   result.summary_output = final_path;
   options.progress = progress;
   if (run.checkpoint) {
-    std::int64_t step = 0;
-    try {
-      step = checkpoint_step(run.checkpoint->state);
-    } catch (const StateError& e) {
-      throw InputError(stored + ": " + e.what());
-    }
     options.resume_state = &run.checkpoint->state;
-    result.message = "continued from the checkpoint at t = " + setting_text(static_cast<double>(step) * scene.run.dt) + " s";
+    result.message =
+        "continued from the checkpoint at t = " + setting_text(static_cast<double>(run.checkpoint->step) * scene.run.dt) + " s";
   } else {
     // No checkpoint: the run is made again from the start, which gives the same file.
     std::string why = run.damaged_slots > 0 ? "its checkpoint was cut short"

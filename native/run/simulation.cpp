@@ -80,7 +80,7 @@ std::int64_t kill_at_step() {
 }
 
 /// The checkpoint's layout; a file written with another one is refused on --resume.
-constexpr std::uint32_t kCheckpointFormat = 1;
+constexpr std::uint32_t kCheckpointFormat = 2;
 
 /// The driver's running figures: what run_scene carries from step to step besides the
 /// engine, the tow, the collision tracker and the contact loads.
@@ -122,15 +122,15 @@ RecordedRows restore_rows(StateReader& in) {
   return r;
 }
 
-}  // namespace
-
-std::int64_t checkpoint_step(const std::vector<std::uint8_t>& state) {
-  StateReader in(state.data(), state.size());
+/// Reads a checkpoint's header: its layout (StateError when not this floedem's) and its step.
+std::int64_t read_checkpoint_header(StateReader& in) {
   in.tag("floedem checkpoint");
   if (in.value<std::uint32_t>() != kCheckpointFormat)
     throw StateError("checkpoint written by a floedem with another checkpoint layout");
   return in.value<std::int64_t>();
 }
+
+}  // namespace
 
 RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -154,17 +154,14 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   if (options.resume_state) {
     const std::vector<std::uint8_t>& bytes = *options.resume_state;
     StateReader in(bytes.data(), bytes.size());
-    const std::int64_t at = checkpoint_step(bytes);
-    in.tag("floedem checkpoint");
-    in.value<std::uint32_t>();
-    in.value<std::int64_t>();
+    const std::int64_t at = read_checkpoint_header(in);
     if (at > steps)
       throw InputError(scene.source_path + ": run.duration " + setting_text(scene.run.duration) +
                        " s ends before the checkpoint (t = " + setting_text(static_cast<double>(at) * scene.run.dt) +
                        " s) that the run continues from");
     const RecordedRows rows = restore_rows(in);
-    tally.restore(in);
     stepper.restore(in);
+    tally.restore(in);
     collisions.restore(in);
     loads.restore(in);
     energy.restore(in);
@@ -191,7 +188,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   };
   // A checkpoint after each full chunk of frames (when the frames are written anyway): the
   // state after step k and the rows written by then. Engines that cannot save their state
-  // get none (and --resume refuses their runs).
+  // get none (--resume then runs them again from the start).
   StateWriter checkpoint_bytes;
   bool checkpoints = true;
   auto checkpoint = [&](std::int64_t k) {
@@ -201,13 +198,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     out.value(kCheckpointFormat);
     out.value(k);
     save_rows(out, recorder.rows());
-    ++tally.checkpoints;
-    tally.save(out);
     if (!stepper.save(out)) {
       checkpoints = false;
-      --tally.checkpoints;
       return;
     }
+    ++tally.checkpoints;
+    tally.save(out);
     collisions.save(out);
     loads.save(out);
     energy.save(out);

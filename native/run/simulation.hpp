@@ -57,10 +57,6 @@ struct RunSummary {
 /// file is made), OutputError, SolverFailure.
 RunSummary run_scene(const Scene& scene, const RunOptions& options);
 
-/// The step a checkpoint was taken after (StateError when it is not a checkpoint this
-/// floedem can read).
-std::int64_t checkpoint_step(const std::vector<std::uint8_t>& state);
-
 /// Multi-line human summary.
 std::string format_summary(const Scene& scene, const RunSummary& s, const std::string& output);
 

@@ -17,23 +17,21 @@ void Stepper::step() {
 }
 
 bool Stepper::save(StateWriter& out) const {
-  StateWriter engine;
-  if (!engine_->save_state(engine)) return false;
+  const std::size_t start = out.size();
   out.tag("stepper");
   out.value(steps_);
-  out.vector(engine.bytes());
-  tow_.save(out);
+  if (!engine_->save_state(out)) {
+    out.truncate(start);
+    return false;
+  }
+  tow_.save(out);  // its tag also tells, on reading, where the engine's state must have ended
   return true;
 }
 
 void Stepper::restore(StateReader& in) {
   in.tag("stepper");
   in.value(steps_);
-  std::vector<std::uint8_t> engine;
-  in.vector(engine);
-  StateReader engine_in(engine.data(), engine.size());
-  engine_->restore_state(engine_in);
-  if (engine_in.left() != 0) throw StateError("checkpoint: the engine's state is longer than the engine reads");
+  engine_->restore_state(in);
   tow_.restore(in);
 }
 

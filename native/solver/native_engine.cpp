@@ -340,7 +340,7 @@ double NativeEngine::kinematic_work() const {
   for (const Manifold& m : manifolds_) {
     const bool a_kinematic = bodies_.inv_mass[m.body_a] == 0.0, b_kinematic = bodies_.inv_mass[m.body_b] == 0.0;
     if (!a_kinematic && !b_kinematic) continue;
-    const Vec2 t{-m.normal.y, m.normal.x};
+    const Vec2 t = perp(m.normal);
     for (int k = 0; k < m.point_count; ++k) {
       const ManifoldPoint& p = m.points[k];
       const Vec2 impulse_on_b = p.normal_impulse * m.normal + p.tangent_impulse * t;

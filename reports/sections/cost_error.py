@@ -29,7 +29,7 @@ import numpy as np
 
 from report_runner import Run
 from sections import towing
-from sections.speed import ITERATIONS_KEY
+from sections.speed import ITERATIONS_KEY, read_row
 
 CORIOLIS_OMEGA = 7.2921e-5
 RESOLUTION = {"impact": 1e-9, "drift": 1e-3}   # towing: the reference's standard error, relative
@@ -126,12 +126,6 @@ def towing_mean(path, s_stat):
         t, _, ice, x = towing.tow_series(f)
     keep = towing.window(t, x, s_stat)
     return float(np.mean(ice[keep])), towing.block_se(t[keep], ice[keep])
-
-
-def read_row(path):
-    import csv
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))[-1]
 
 
 def write(ctx):
