@@ -144,6 +144,23 @@ int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, int max_itera
   return sweep;
 }
 
+int clamp_friction(std::span<Manifold> manifolds, BodyArrays& s) {
+  int cut = 0;
+  for (Manifold& m : manifolds) {
+    const Vec2 t = perp(m.normal);
+    for (int k = 0; k < m.point_count; ++k) {
+      ManifoldPoint& p = m.points[k];
+      const double limit = m.friction * p.normal_impulse;
+      const double pt = std::clamp(p.tangent_impulse, -limit, limit);
+      if (pt == p.tangent_impulse) continue;
+      apply_impulse(s, m, p, (pt - p.tangent_impulse) * t);
+      p.tangent_impulse = pt;
+      ++cut;
+    }
+  }
+  return cut;
+}
+
 double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const NativeSettings& settings) {
   double deepest = 0.0;
   for (int iteration = 0; iteration < settings.position_iterations; ++iteration) {

@@ -33,6 +33,10 @@ void warm_start(std::span<const Manifold> manifolds, BodyArrays& bodies);
 /// impulse, or max_iterations. Returns the number of sweeps made.
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, int max_iterations, double tolerance);
 
+/// Cuts every friction impulse back to its cone |P_t| <= mu P_n (after the normals changed),
+/// applying the difference to the bodies. Returns how many were cut.
+int clamp_friction(std::span<Manifold> manifolds, BodyArrays& bodies);
+
 /// Nonlinear Gauss-Seidel on positions (Box2D v2.4's position solver): pushes overlapping
 /// bodies apart beyond `allowed_penetration`, touching positions only, never velocities, so
 /// that drift correction adds no kinetic energy. Returns the deepest penetration found (m, >= 0).

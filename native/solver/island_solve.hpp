@@ -1,0 +1,79 @@
+#pragma once
+// A direct solve of the normal contact impulses of the islands that Gauss-Seidel cannot hold:
+// heavy-light chains (an iceberg pressing light floes against a wall).
+// The equations and the method are in island_solve.cpp.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include "solver/contact_solver.hpp"
+
+namespace floedem {
+
+/// What one call did, for the engine's counters and the tests.
+struct IslandSolveOutcome {
+  bool applied = false;       ///< impulses and velocities were changed
+  int points = 0;             ///< contact points in the islands solved
+  int pressing = 0;           ///< points with a normal impulse in the solution
+  int rounds = 0;             ///< active-set rounds (a factorisation each)
+  double worst_before = 0.0;  ///< m/s, the largest approach velocity left beyond the target
+};
+
+class IslandSolver {
+ public:
+  /// Chooses the islands to solve: those holding a point that still approaches faster than its
+  /// target by more than `trigger_velocity` (m/s) and whose heaviest body is at least
+  /// `mass_ratio` times their lightest. Islands: bodies joined by contacts; fixed and
+  /// prescribed bodies (infinite mass) join nothing. Returns whether there is any.
+  bool select(std::span<const Manifold> manifolds, const BodyArrays& bodies, double trigger_velocity, double mass_ratio);
+
+  /// Solves the normal impulses of the chosen islands directly, friction held as it is, and
+  /// updates impulses and velocities; leaves everything as it was when the pressing set does
+  /// not settle.
+  IslandSolveOutcome solve(std::span<Manifold> manifolds, BodyArrays& bodies);
+
+  /// The manifolds of the chosen islands (indices, ascending).
+  std::span<const std::int32_t> island_manifolds() const { return manifolds_; }
+
+ private:
+  struct Point {
+    std::int32_t manifold;
+    std::int32_t index;  ///< 0 or 1 within the manifold
+    std::int32_t a, b;   ///< bodies
+  };
+  const ManifoldPoint& point(std::span<const Manifold> manifolds, std::size_t i) const {
+    return manifolds[points_[i].manifold].points[points_[i].index];
+  }
+  std::int32_t find(std::int32_t body);
+  void apply(std::span<const Manifold> manifolds, BodyArrays& bodies, std::size_t i, double pn, double pt) const;
+  double velocity_along(std::span<const Manifold> manifolds, const BodyArrays& bodies, std::size_t i,
+                        bool tangent) const;
+  bool solve_active(std::span<const Manifold> manifolds, const BodyArrays& bodies);
+
+  std::vector<Point> points_;               // the islands' points
+  std::vector<std::int32_t> manifolds_;     // the islands' manifolds
+  std::vector<std::uint8_t> active_;        // per point: in the pressing set
+  std::vector<double> normal_;              // per point: normal impulse being solved for
+  std::vector<double> free_velocity_;       // per point: u_n without the islands' impulses
+  std::vector<std::int32_t> row_, rows_;    // per point: its row or -1; per row: its point
+  std::vector<std::int32_t> wrong_;         // points whose answer breaks their conditions
+  std::vector<std::int32_t> root_;          // union-find over bodies
+  std::vector<std::uint8_t> in_island_;     // per island root: solved
+  std::vector<double> largest_inv_mass_, smallest_inv_mass_;  // per island root
+  std::vector<std::int32_t> body_start_;    // per body + 1: where its rows begin in body_row_
+  std::vector<std::int32_t> body_row_;      // rows grouped by body (each row under a and b)
+  std::vector<std::int32_t> fill_;          // per body: fill cursor into body_row_
+  std::vector<Vec2> free_linear_, saved_linear_;  // body velocities without the islands' impulses; as found
+  std::vector<double> free_angular_, saved_angular_;
+  std::vector<Eigen::Triplet<double>> triplets_;
+  Eigen::SparseMatrix<double> a_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+  double refine_to_ = 0.0;  // m/s: the velocity residual the refinement stops at
+  double trigger_velocity_ = 0.0;
+  double worst_before_ = 0.0;
+};
+
+}  // namespace floedem
