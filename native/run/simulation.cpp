@@ -80,7 +80,7 @@ std::int64_t kill_at_step() {
 }
 
 /// The checkpoint's layout; a file written with another one is refused on --resume.
-constexpr std::uint32_t kCheckpointFormat = 3;
+constexpr std::uint32_t kCheckpointFormat = 4;
 
 /// The driver's running figures: what run_scene carries from step to step besides the
 /// engine, the tow, the collision tracker and the contact loads.

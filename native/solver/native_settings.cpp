@@ -18,6 +18,7 @@ NativeSettings read_native_settings(const Scene& scene) {
   s.position_correction = r.real("position_correction", s.position_correction, Range{0.0, 1.0, true, false});
   s.allowed_penetration = r.real("allowed_penetration", s.allowed_penetration, Range::non_negative());
   s.max_correction = r.real("max_correction", s.max_correction, Range::positive());
+  s.redetect = r.boolean("redetect", s.redetect);
   s.direct_solve = r.boolean("direct_solve", s.direct_solve);
   s.direct_solve_mass_ratio = r.real("direct_solve_mass_ratio", s.direct_solve_mass_ratio, Range{1.0, std::numeric_limits<double>::infinity(), false, true});
   r.reject_unknown();
