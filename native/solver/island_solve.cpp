@@ -19,7 +19,7 @@
 //   u_n = u_free + A P_n,   P_n >= 0,   u_n - u* >= 0,   P_n . (u_n - u*) = 0,
 //
 // u_free: the normal velocities with the islands' normal impulses taken away (friction held as
-// Gauss-Seidel left it); u*: each point's target (Newton's law for a collision, -gap/dt at
+// Gauss-Seidel left it, or taken away too); u*: each point's target (Newton's law for a collision, -gap/dt at
 // rest); A = W_nn = J_n M^-1 J_n^T, for points i and j sharing body c (s = -1 if c is the
 // point's a, +1 if its b; r the lever arms):
 //
@@ -33,10 +33,12 @@
 // singular: A + eps diag(A) is factorised (eps = 1e-10 after Jacobi scaling) and the
 // equalities solved to the velocity tolerance by iterative refinement on A itself.
 //
-// The engine alternates this solve with Gauss-Seidel sweeps, which bring friction back to its
-// law (stick or slide) for the new normals, and ends with it: normals exact; friction then cut
-// back to the cone where a normal impulse fell (a small cut: the sweeps had it right for
-// nearly these normals; where a point lets go, its friction goes with it).
+// The engine solves first without friction (the sweeps' friction was found against their wrong
+// normals: held, it throws light floes sideways), then alternates this solve with Gauss-Seidel
+// sweeps, which bring friction back to its law (stick or slide) for the new normals, and ends
+// with it: normals exact; friction then cut back to the cone where a normal impulse fell (a
+// small cut: the sweeps had it right for nearly these normals; where a point lets go, its
+// friction goes with it).
 
 namespace floedem {
 
@@ -131,7 +133,7 @@ bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays&
   return true;
 }
 
-IslandSolveOutcome IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays& s) {
+IslandSolveOutcome IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays& s, bool without_friction) {
   IslandSolveOutcome out;
   out.worst_before = worst_before_;
   const std::size_t np = points_.size();
@@ -143,16 +145,18 @@ IslandSolveOutcome IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays
   };
 
   // 3. The first pressing set (pressed by Gauss-Seidel, or still approaching); then the
-  // velocities without the islands' normal impulses.
+  // velocities without the islands' normal impulses (and friction, if asked).
   saved_linear_ = s.velocity;
   saved_angular_ = s.angular_velocity;
   active_.assign(np, 0);
   normal_.resize(np);
+  start_.resize(np);
   for (std::size_t i = 0; i < np; ++i) {
     const Manifold& m = manifolds[points_[i].manifold];
     const ManifoldPoint& q = point(manifolds, i);
     active_[i] = q.normal_impulse > 0.0 || shortfall(m, q) > 0.0;
-    apply(manifolds, s, i, -q.normal_impulse, 0.0);
+    start_[i] = q.normal_impulse;
+    apply(manifolds, s, i, -q.normal_impulse, without_friction ? -q.tangent_impulse : 0.0);
   }
   free_linear_ = s.velocity;
   free_angular_ = s.angular_velocity;
@@ -196,6 +200,7 @@ IslandSolveOutcome IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays
     else
       for (const std::int32_t i : wrong_) active_[static_cast<std::size_t>(i)] ^= 1;
   }
+  if (!settled) settled = solve_by_descent(manifolds, s, out);
   if (!settled) {  // Gauss-Seidel's answer stays
     s.velocity = saved_linear_;
     s.angular_velocity = saved_angular_;
@@ -204,10 +209,58 @@ IslandSolveOutcome IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays
   for (std::size_t i = 0; i < np; ++i) {
     ManifoldPoint& q = manifolds[points_[i].manifold].points[points_[i].index];
     q.normal_impulse = normal_[i];
+    if (without_friction) q.tangent_impulse = 0.0;
     out.pressing += normal_[i] > 0.0 ? 1 : 0;
   }
   out.applied = true;
   return out;
+}
+
+bool IslandSolver::solve_by_descent(std::span<const Manifold> manifolds, BodyArrays& s, IslandSolveOutcome& out) {
+  // When the pivoting does not settle (it can wander where redundant points make A nearly
+  // singular): the same problem as the convex program min 1/2 P'AP + P'(u_free - u*), P >= 0,
+  // by the active-set method of Lawson and Hanson (1974, "Solving least squares problems",
+  // ch. 23), from Gauss-Seidel's impulses: solve the equalities of the pressing set; where that
+  // would make an impulse negative, step only as far as keeps every impulse >= 0 and let go of
+  // those at 0; then take in every point still approaching. Each step lowers the objective, so
+  // it does not cycle as pivoting can.
+  const std::size_t np = points_.size();
+  const double tolerance = 1e-2 * trigger_velocity_;
+  std::vector<double>& now = start_;  // feasible impulses, Gauss-Seidel's to begin with
+  for (std::size_t i = 0; i < np; ++i) active_[i] = now[i] > 0.0;
+  const int limit = 4 * static_cast<int>(np) + 10;
+  for (int round = 0; round < limit; ++round) {
+    ++out.rounds;
+    if (!solve_active(manifolds, s)) return false;
+    for (int inner = 0; inner < limit; ++inner) {
+      double alpha = 1.0;
+      for (std::size_t i = 0; i < np; ++i)
+        if (active_[i] && normal_[i] <= 0.0) alpha = std::min(alpha, now[i] / (now[i] - normal_[i]));
+      if (alpha >= 1.0) break;
+      for (std::size_t i = 0; i < np; ++i) {
+        now[i] = active_[i] ? now[i] + alpha * (normal_[i] - now[i]) : 0.0;
+        if (active_[i] && now[i] <= 0.0) {
+          active_[i] = 0;
+          now[i] = 0.0;
+        }
+      }
+      ++out.rounds;
+      if (!solve_active(manifolds, s)) return false;
+    }
+    for (std::size_t i = 0; i < np; ++i) now[i] = active_[i] ? std::max(normal_[i], 0.0) : 0.0;
+    normal_ = now;
+    s.velocity = free_linear_;
+    s.angular_velocity = free_angular_;
+    for (std::size_t i = 0; i < np; ++i) apply(manifolds, s, i, normal_[i], 0.0);
+    bool added = false;
+    for (std::size_t i = 0; i < np; ++i)
+      if (!active_[i] && velocity_along(manifolds, s, i, false) < point(manifolds, i).target_velocity - tolerance) {
+        active_[i] = 1;
+        added = true;
+      }
+    if (!added) return true;
+  }
+  return false;
 }
 
 bool IslandSolver::solve_active(std::span<const Manifold> manifolds, const BodyArrays& s) {

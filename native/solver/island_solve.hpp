@@ -30,10 +30,10 @@ class IslandSolver {
   /// prescribed bodies (infinite mass) join nothing. Returns whether there is any.
   bool select(std::span<const Manifold> manifolds, const BodyArrays& bodies, double trigger_velocity, double mass_ratio);
 
-  /// Solves the normal impulses of the chosen islands directly, friction held as it is, and
-  /// updates impulses and velocities; leaves everything as it was when the pressing set does
-  /// not settle.
-  IslandSolveOutcome solve(std::span<Manifold> manifolds, BodyArrays& bodies);
+  /// Solves the normal impulses of the chosen islands directly, friction held as it is (or
+  /// taken off, without_friction), and updates impulses and velocities; leaves everything as
+  /// it was when the pressing set does not settle.
+  IslandSolveOutcome solve(std::span<Manifold> manifolds, BodyArrays& bodies, bool without_friction);
 
   /// The manifolds of the chosen islands (indices, ascending).
   std::span<const std::int32_t> island_manifolds() const { return manifolds_; }
@@ -52,11 +52,13 @@ class IslandSolver {
   double velocity_along(std::span<const Manifold> manifolds, const BodyArrays& bodies, std::size_t i,
                         bool tangent) const;
   bool solve_active(std::span<const Manifold> manifolds, const BodyArrays& bodies);
+  bool solve_by_descent(std::span<const Manifold> manifolds, BodyArrays& bodies, IslandSolveOutcome& out);
 
   std::vector<Point> points_;               // the islands' points
   std::vector<std::int32_t> manifolds_;     // the islands' manifolds
   std::vector<std::uint8_t> active_;        // per point: in the pressing set
   std::vector<double> normal_;              // per point: normal impulse being solved for
+  std::vector<double> start_;               // per point: Gauss-Seidel's normal impulse (the descent's start)
   std::vector<double> free_velocity_;       // per point: u_n without the islands' impulses
   std::vector<std::int32_t> row_, rows_;    // per point: its row or -1; per row: its point
   std::vector<std::int32_t> wrong_;         // points whose answer breaks their conditions

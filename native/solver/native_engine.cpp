@@ -453,8 +453,11 @@ void NativeEngine::solve_islands_directly(double before) {
     }
   saved_velocity_ = bodies_.velocity;
   saved_angular_velocity_ = bodies_.angular_velocity;
-  if (!island_solver_.solve(manifolds_, bodies_).applied) return;
-  // Friction was held: sweeps bring it back to its law for the new normals, and the normals are
+  // First the normals alone, friction taken off: the sweeps' friction was found against their
+  // wrong normals (in a heavy-light chain, tangential impulses of the size of the wrong normal
+  // ones), and held it throws light floes sideways.
+  if (!island_solver_.solve(manifolds_, bodies_, /*without_friction=*/true).applied) return;
+  // Then sweeps bring friction back to its law for the exact normals, and the normals are
   // solved again with the friction they leave (the sweeps cannot hold the normals of a
   // heavy-light chain themselves), until the sweeps leave them within the trigger. Last,
   // friction beyond a fallen normal's cone is cut back to it (island_solve.cpp).
@@ -466,7 +469,7 @@ void NativeEngine::solve_islands_directly(double before) {
   for (int pass = 0; pass < 3; ++pass) {
     total_sweeps_ += solve_velocities(island_manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
     if (!island_solver_.select(island_manifolds_, bodies_, trigger, settings_.direct_solve_mass_ratio) ||
-        !island_solver_.solve(island_manifolds_, bodies_).applied)
+        !island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false).applied)
       break;
   }
   clamp_friction(island_manifolds_, bodies_);
