@@ -39,13 +39,14 @@ TEST_CASE("island solve: an iceberg 1e8 times a floe's mass is stopped by the fl
     engine->step(nullptr);
     const BodyStates& b = engine->state();
     // Normal velocities to the solve's tolerance: 1e-2 of its trigger, 1e-3 allowed_penetration
-    // / dt = 2e-5 m/s (an overlap growing by 1e-8 m a step). Sideways, the friction sweeps
-    // stop when no impulse changes by more than 1e-10 of the largest (1e9 N s here), which
-    // leaves a 99 kg floe up to ~1e-3 m/s: sideways drift within it, not the 0.2 m/s at stake.
+    // / dt = 2e-5 m/s (an overlap growing by 1e-8 m a step). Sideways the floes stay put: the
+    // first solve takes the sweeps' friction off (found against their wrong normals, held it
+    // threw these floes sideways at up to 4e-4 m/s) and the sweeps rebuild it against the exact
+    // normals (measured: under 1e-8 m/s).
     CHECK(b.velocity[4].x == Approx(0.2 * e).margin(2e-7));
     for (int k = 1; k <= 3; ++k) {
       CHECK(std::abs(b.velocity[k].x) < 2e-7);
-      CHECK(std::abs(b.velocity[k].y) < 1e-3);
+      CHECK(std::abs(b.velocity[k].y) < 1e-7);
     }
     CHECK(kinetic_energy(s, b) <= before);
     CHECK(engine->info().settings.at("direct_solves") == "1");
