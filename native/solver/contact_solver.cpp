@@ -91,25 +91,13 @@ void prepare_contacts(std::span<Manifold> manifolds, const BodyArrays& s, double
   }
 }
 
-namespace {
-
-inline void apply_impulse(BodyArrays& s, const Manifold& m, const ManifoldPoint& p, Vec2 impulse) {
-  const int a = m.body_a, b = m.body_b;
-  s.velocity[a] -= s.inv_mass[a] * impulse;
-  s.angular_velocity[a] -= s.inv_inertia[a] * cross(p.ra, impulse);
-  s.velocity[b] += s.inv_mass[b] * impulse;
-  s.angular_velocity[b] += s.inv_inertia[b] * cross(p.rb, impulse);
-}
-
-}  // namespace
-
-void warm_start(std::span<const Manifold> manifolds, BodyArrays& s) {
+void apply_accumulated_impulses(std::span<const Manifold> manifolds, BodyArrays& s, double sign) {
   for (const Manifold& m : manifolds) {
     const Vec2 t = perp(m.normal);
     for (int k = 0; k < m.point_count; ++k) {
       const ManifoldPoint& p = m.points[k];
       if (p.normal_impulse != 0.0 || p.tangent_impulse != 0.0)
-        apply_impulse(s, m, p, p.normal_impulse * m.normal + p.tangent_impulse * t);
+        apply_impulse(s, m, p, sign * (p.normal_impulse * m.normal + p.tangent_impulse * t));
     }
   }
 }

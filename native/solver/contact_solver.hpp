@@ -26,8 +26,21 @@ inline Vec2 relative_velocity(const BodyArrays& s, int a, int b, Vec2 ra, Vec2 r
 /// target normal velocity, and fills the Delassus block.
 void prepare_contacts(std::span<Manifold> manifolds, const BodyArrays& bodies, double dt, double collision_threshold);
 
-/// Applies the accumulated (warm-start) impulses.
-void warm_start(std::span<const Manifold> manifolds, BodyArrays& bodies);
+/// Applies `impulse` (on b; its opposite on a) at point p of manifold m.
+inline void apply_impulse(BodyArrays& s, const Manifold& m, const ManifoldPoint& p, Vec2 impulse) {
+  const int a = m.body_a, b = m.body_b;
+  s.velocity[a] -= s.inv_mass[a] * impulse;
+  s.angular_velocity[a] -= s.inv_inertia[a] * cross(p.ra, impulse);
+  s.velocity[b] += s.inv_mass[b] * impulse;
+  s.angular_velocity[b] += s.inv_inertia[b] * cross(p.rb, impulse);
+}
+
+/// Applies the accumulated impulses times `sign`: +1 for the warm start, -1 to take a solve's
+/// impulses off again (they are all it applied).
+void apply_accumulated_impulses(std::span<const Manifold> manifolds, BodyArrays& bodies, double sign);
+inline void warm_start(std::span<const Manifold> manifolds, BodyArrays& bodies) {
+  apply_accumulated_impulses(manifolds, bodies, 1.0);
+}
 
 /// Gauss-Seidel sweeps until the largest impulse change is below tolerance times the largest
 /// impulse, or max_iterations. Returns the number of sweeps made.

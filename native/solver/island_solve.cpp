@@ -58,38 +58,42 @@ std::int32_t IslandSolver::find(std::int32_t body) {
   return body;
 }
 
-double IslandSolver::velocity_along(std::span<const Manifold> manifolds, const BodyArrays& s, std::size_t i,
-                                    bool tangent) const {
-  const Manifold& m = manifolds[points_[i].manifold];
-  const ManifoldPoint& q = m.points[points_[i].index];
-  return dot(relative_velocity(s, points_[i].a, points_[i].b, q.ra, q.rb), tangent ? perp(m.normal) : m.normal);
+double IslandSolver::normal_velocity(const Manifold& m, const ManifoldPoint& q, const BodyArrays& s) {
+  return dot(relative_velocity(s, m.body_a, m.body_b, q.ra, q.rb), m.normal);
+}
+
+double IslandSolver::shortfall(const Manifold& m, const ManifoldPoint& q, const BodyArrays& s) {
+  return q.target_velocity - normal_velocity(m, q, s);
 }
 
 void IslandSolver::apply(std::span<const Manifold> manifolds, BodyArrays& s, std::size_t i, double pn,
                          double pt) const {
   if (pn == 0.0 && pt == 0.0) return;
-  const Point& p = points_[i];
-  const Manifold& m = manifolds[p.manifold];
-  const ManifoldPoint& q = m.points[p.index];
-  const Vec2 impulse = pn * m.normal + pt * perp(m.normal);
-  s.velocity[p.a] -= s.inv_mass[p.a] * impulse;
-  s.angular_velocity[p.a] -= s.inv_inertia[p.a] * cross(q.ra, impulse);
-  s.velocity[p.b] += s.inv_mass[p.b] * impulse;
-  s.angular_velocity[p.b] += s.inv_inertia[p.b] * cross(q.rb, impulse);
+  const Manifold& m = manifolds[points_[i].manifold];
+  apply_impulse(s, m, m.points[points_[i].index], pn * m.normal + pt * perp(m.normal));
+}
+
+void IslandSolver::apply_normals(std::span<const Manifold> manifolds, BodyArrays& s) const {
+  s.velocity = free_linear_;
+  s.angular_velocity = free_angular_;
+  for (std::size_t i = 0; i < points_.size(); ++i) apply(manifolds, s, i, normal_[i], 0.0);
+}
+
+bool IslandSolver::approaching(std::span<const Manifold> manifolds, const BodyArrays& s, std::size_t i,
+                               double tolerance) const {
+  const ManifoldPoint& q = point(manifolds, i);
+  return normal_velocity(manifolds[points_[i].manifold], q, s) < q.target_velocity - tolerance;
 }
 
 bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays& s, double trigger_velocity,
                           double mass_ratio) {
   trigger_velocity_ = trigger_velocity;
-  worst_before_ = 0.0;
   // 1. Is there a point left approaching beyond its target by more than the trigger?
-  auto shortfall = [&](const Manifold& m, const ManifoldPoint& q) {
-    return q.target_velocity - dot(relative_velocity(s, m.body_a, m.body_b, q.ra, q.rb), m.normal);
-  };
+  double worst = 0.0;
   for (const Manifold& m : manifolds)
-    for (int k = 0; k < m.point_count; ++k) worst_before_ = std::max(worst_before_, shortfall(m, m.points[k]));
+    for (int k = 0; k < m.point_count; ++k) worst = std::max(worst, shortfall(m, m.points[k], s));
   points_.clear();
-  if (worst_before_ <= trigger_velocity) return false;
+  if (worst <= trigger_velocity) return false;
 
   // 2. Islands (union-find over moving bodies); the points of those holding such a point whose
   // heaviest body is at least mass_ratio times its lightest.
@@ -117,7 +121,7 @@ bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays&
   for (const Manifold& m : manifolds)
     for (int k = 0; k < m.point_count; ++k) {
       const std::int32_t root = island(m);
-      if (shortfall(m, m.points[k]) > trigger_velocity && largest_inv_mass_[root] >= mass_ratio * smallest_inv_mass_[root]) {
+      if (shortfall(m, m.points[k], s) > trigger_velocity && largest_inv_mass_[root] >= mass_ratio * smallest_inv_mass_[root]) {
         in_island_[root] = 1;
         any = true;
       }
@@ -133,16 +137,9 @@ bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays&
   return true;
 }
 
-IslandSolveOutcome IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays& s, bool without_friction) {
-  IslandSolveOutcome out;
-  out.worst_before = worst_before_;
+bool IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays& s, bool without_friction) {
   const std::size_t np = points_.size();
-  out.points = static_cast<int>(np);
-  if (np == 0) return out;
-  const double trigger_velocity = trigger_velocity_;
-  auto shortfall = [&](const Manifold& m, const ManifoldPoint& q) {
-    return q.target_velocity - dot(relative_velocity(s, m.body_a, m.body_b, q.ra, q.rb), m.normal);
-  };
+  if (np == 0) return false;
 
   // 3. The first pressing set (pressed by Gauss-Seidel, or still approaching); then the
   // velocities without the islands' normal impulses (and friction, if asked).
@@ -153,36 +150,33 @@ IslandSolveOutcome IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays
   start_.resize(np);
   for (std::size_t i = 0; i < np; ++i) {
     const Manifold& m = manifolds[points_[i].manifold];
-    const ManifoldPoint& q = point(manifolds, i);
-    active_[i] = q.normal_impulse > 0.0 || shortfall(m, q) > 0.0;
+    const ManifoldPoint& q = m.points[points_[i].index];
+    active_[i] = q.normal_impulse > 0.0 || shortfall(m, q, s) > 0.0;
     start_[i] = q.normal_impulse;
     apply(manifolds, s, i, -q.normal_impulse, without_friction ? -q.tangent_impulse : 0.0);
   }
   free_linear_ = s.velocity;
   free_angular_ = s.angular_velocity;
   free_velocity_.resize(np);
-  for (std::size_t i = 0; i < np; ++i) free_velocity_[i] = velocity_along(manifolds, s, i, false);
+  for (std::size_t i = 0; i < np; ++i)
+    free_velocity_[i] = normal_velocity(manifolds[points_[i].manifold], point(manifolds, i), s);
 
   // 4. Block principal pivoting.
-  const double tolerance = 1e-2 * trigger_velocity;  // m/s, left as solved
+  const double tolerance = 1e-2 * trigger_velocity_;  // m/s, left as solved
   refine_to_ = 1e-2 * tolerance;
   std::size_t best_wrong = np + 1;
   int rounds_without_progress = 0;
   bool settled = false;
   for (int round = 0; round < max_rounds && !settled; ++round) {
-    ++out.rounds;
     if (!solve_active(manifolds, s)) break;
-    s.velocity = free_linear_;
-    s.angular_velocity = free_angular_;
-    for (std::size_t i = 0; i < np; ++i) apply(manifolds, s, i, normal_[i], 0.0);
+    apply_normals(manifolds, s);
     // A pulling point: below -1e-9 of the largest impulse (redundant points share their load
     // arbitrarily, and their rounding noise must not read as pulling).
     double largest = 0.0;
     for (std::size_t i = 0; i < np; ++i) largest = std::max(largest, std::abs(normal_[i]));
     wrong_.clear();
     for (std::size_t i = 0; i < np; ++i) {
-      if (active_[i] ? normal_[i] < -1e-9 * largest
-                     : velocity_along(manifolds, s, i, false) < point(manifolds, i).target_velocity - tolerance)
+      if (active_[i] ? normal_[i] < -1e-9 * largest : approaching(manifolds, s, i, tolerance))
         wrong_.push_back(static_cast<std::int32_t>(i));
     }
     if (wrong_.empty()) {
@@ -200,23 +194,21 @@ IslandSolveOutcome IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays
     else
       for (const std::int32_t i : wrong_) active_[static_cast<std::size_t>(i)] ^= 1;
   }
-  if (!settled) settled = solve_by_descent(manifolds, s, out);
+  if (!settled) settled = solve_by_descent(manifolds, s);
   if (!settled) {  // Gauss-Seidel's answer stays
     s.velocity = saved_linear_;
     s.angular_velocity = saved_angular_;
-    return out;
+    return false;
   }
   for (std::size_t i = 0; i < np; ++i) {
     ManifoldPoint& q = manifolds[points_[i].manifold].points[points_[i].index];
     q.normal_impulse = normal_[i];
     if (without_friction) q.tangent_impulse = 0.0;
-    out.pressing += normal_[i] > 0.0 ? 1 : 0;
   }
-  out.applied = true;
-  return out;
+  return true;
 }
 
-bool IslandSolver::solve_by_descent(std::span<const Manifold> manifolds, BodyArrays& s, IslandSolveOutcome& out) {
+bool IslandSolver::solve_by_descent(std::span<const Manifold> manifolds, BodyArrays& s) {
   // When the pivoting does not settle (it can wander where redundant points make A nearly
   // singular): the same problem as the convex program min 1/2 P'AP + P'(u_free - u*), P >= 0,
   // by the active-set method of Lawson and Hanson (1974, "Solving least squares problems",
@@ -230,7 +222,6 @@ bool IslandSolver::solve_by_descent(std::span<const Manifold> manifolds, BodyArr
   for (std::size_t i = 0; i < np; ++i) active_[i] = now[i] > 0.0;
   const int limit = 4 * static_cast<int>(np) + 10;
   for (int round = 0; round < limit; ++round) {
-    ++out.rounds;
     if (!solve_active(manifolds, s)) return false;
     for (int inner = 0; inner < limit; ++inner) {
       double alpha = 1.0;
@@ -244,17 +235,14 @@ bool IslandSolver::solve_by_descent(std::span<const Manifold> manifolds, BodyArr
           now[i] = 0.0;
         }
       }
-      ++out.rounds;
       if (!solve_active(manifolds, s)) return false;
     }
     for (std::size_t i = 0; i < np; ++i) now[i] = active_[i] ? std::max(normal_[i], 0.0) : 0.0;
     normal_ = now;
-    s.velocity = free_linear_;
-    s.angular_velocity = free_angular_;
-    for (std::size_t i = 0; i < np; ++i) apply(manifolds, s, i, normal_[i], 0.0);
+    apply_normals(manifolds, s);
     bool added = false;
     for (std::size_t i = 0; i < np; ++i)
-      if (!active_[i] && velocity_along(manifolds, s, i, false) < point(manifolds, i).target_velocity - tolerance) {
+      if (!active_[i] && approaching(manifolds, s, i, tolerance)) {
         active_[i] = 1;
         added = true;
       }
@@ -267,13 +255,10 @@ bool IslandSolver::solve_active(std::span<const Manifold> manifolds, const BodyA
   // Rows: the pressing points; each body's rows grouped (CSR).
   const std::size_t np = points_.size();
   const std::size_t nb = s.position.size();
-  row_.assign(np, -1);
   rows_.clear();
   for (std::size_t i = 0; i < np; ++i) {
     normal_[i] = 0.0;
-    if (!active_[i]) continue;
-    row_[i] = static_cast<std::int32_t>(rows_.size());
-    rows_.push_back(static_cast<std::int32_t>(i));
+    if (active_[i]) rows_.push_back(static_cast<std::int32_t>(i));
   }
   const auto nr = static_cast<std::int32_t>(rows_.size());
   if (nr == 0) return true;

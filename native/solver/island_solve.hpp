@@ -13,15 +13,6 @@
 
 namespace floedem {
 
-/// What one call did, for the engine's counters and the tests.
-struct IslandSolveOutcome {
-  bool applied = false;       ///< impulses and velocities were changed
-  int points = 0;             ///< contact points in the islands solved
-  int pressing = 0;           ///< points with a normal impulse in the solution
-  int rounds = 0;             ///< active-set rounds (a factorisation each)
-  double worst_before = 0.0;  ///< m/s, the largest approach velocity left beyond the target
-};
-
 class IslandSolver {
  public:
   /// Chooses the islands to solve: those holding a point that still approaches faster than its
@@ -31,9 +22,9 @@ class IslandSolver {
   bool select(std::span<const Manifold> manifolds, const BodyArrays& bodies, double trigger_velocity, double mass_ratio);
 
   /// Solves the normal impulses of the chosen islands directly, friction held as it is (or
-  /// taken off, without_friction), and updates impulses and velocities; leaves everything as
-  /// it was when the pressing set does not settle.
-  IslandSolveOutcome solve(std::span<Manifold> manifolds, BodyArrays& bodies, bool without_friction);
+  /// taken off, without_friction), and updates impulses and velocities; returns false and
+  /// leaves everything as it was when the pressing set does not settle.
+  bool solve(std::span<Manifold> manifolds, BodyArrays& bodies, bool without_friction);
 
   /// The manifolds of the chosen islands (indices, ascending).
   std::span<const std::int32_t> island_manifolds() const { return manifolds_; }
@@ -47,12 +38,16 @@ class IslandSolver {
   const ManifoldPoint& point(std::span<const Manifold> manifolds, std::size_t i) const {
     return manifolds[points_[i].manifold].points[points_[i].index];
   }
+  static double normal_velocity(const Manifold& m, const ManifoldPoint& q, const BodyArrays& bodies);
+  static double shortfall(const Manifold& m, const ManifoldPoint& q, const BodyArrays& bodies);  ///< u* - u_n
   std::int32_t find(std::int32_t body);
   void apply(std::span<const Manifold> manifolds, BodyArrays& bodies, std::size_t i, double pn, double pt) const;
-  double velocity_along(std::span<const Manifold> manifolds, const BodyArrays& bodies, std::size_t i,
-                        bool tangent) const;
+  /// Velocities: the free ones plus every point's normal_ impulse.
+  void apply_normals(std::span<const Manifold> manifolds, BodyArrays& bodies) const;
+  /// Point i (not pressing) approaches faster than its target by more than tolerance.
+  bool approaching(std::span<const Manifold> manifolds, const BodyArrays& bodies, std::size_t i, double tolerance) const;
   bool solve_active(std::span<const Manifold> manifolds, const BodyArrays& bodies);
-  bool solve_by_descent(std::span<const Manifold> manifolds, BodyArrays& bodies, IslandSolveOutcome& out);
+  bool solve_by_descent(std::span<const Manifold> manifolds, BodyArrays& bodies);
 
   std::vector<Point> points_;               // the islands' points
   std::vector<std::int32_t> manifolds_;     // the islands' manifolds
@@ -60,7 +55,7 @@ class IslandSolver {
   std::vector<double> normal_;              // per point: normal impulse being solved for
   std::vector<double> start_;               // per point: Gauss-Seidel's normal impulse (the descent's start)
   std::vector<double> free_velocity_;       // per point: u_n without the islands' impulses
-  std::vector<std::int32_t> row_, rows_;    // per point: its row or -1; per row: its point
+  std::vector<std::int32_t> rows_;          // per row: its point
   std::vector<std::int32_t> wrong_;         // points whose answer breaks their conditions
   std::vector<std::int32_t> root_;          // union-find over bodies
   std::vector<std::uint8_t> in_island_;     // per island root: solved
@@ -75,7 +70,6 @@ class IslandSolver {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
   double refine_to_ = 0.0;  // m/s: the velocity residual the refinement stops at
   double trigger_velocity_ = 0.0;
-  double worst_before_ = 0.0;
 };
 
 }  // namespace floedem

@@ -42,7 +42,6 @@ class NativeEngine final : public Engine {
   void find_pairs(const Loads* loads);
   void pair_up();
   bool outran_reach();
-  void undo_contact_impulses();
   void build_manifolds();
   void apply_loads(const Loads& loads);
   void integrate();
@@ -104,6 +103,7 @@ NativeEngine::NativeEngine(const Scene& scene)
   bodies_.inv_mass.resize(n);
   bodies_.inv_inertia.resize(n);
   moves_.resize(n);
+  double lightest = std::numeric_limits<double>::infinity(), heaviest = 0.0;  // moving bodies, kg
   for (std::size_t i = 0; i < n; ++i) {
     const BodySpec& b = scene.bodies[i];
     bodies_.position[i] = b.centroid;
@@ -115,13 +115,11 @@ NativeEngine::NativeEngine(const Scene& scene)
     bodies_.inv_inertia[i] = infinite ? 0.0 : 1.0 / scene.engine_inertia(i);
     moves_[i] = b.fixed ? 0 : 1;
     has_prescribed_ = has_prescribed_ || b.prescribed;
-  }
-  double lightest = std::numeric_limits<double>::infinity(), heaviest = 0.0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (bodies_.inv_mass[i] > 0.0) {
-      heaviest = std::max(heaviest, 1.0 / bodies_.inv_mass[i]);
-      lightest = std::min(lightest, 1.0 / bodies_.inv_mass[i]);
+    if (!infinite) {
+      heaviest = std::max(heaviest, scene.engine_mass(i));
+      lightest = std::min(lightest, scene.engine_mass(i));
     }
+  }
   heavy_light_ = settings_.direct_solve && heaviest >= settings_.direct_solve_mass_ratio * lightest;
   part_boxes_.resize(parts_.size());
   linear_reach_.resize(n);
@@ -244,7 +242,10 @@ void NativeEngine::step(const Loads* loads) {
     // contacts are found again with the reach widened, and solved again from the velocities
     // after the loads (classified on those: the only difference from a first pass).
     for (int pass = 0; settings_.redetect && pass < kMaxRedetections && outran_reach(); ++pass) {
-      undo_contact_impulses();
+      // The accumulated impulses are all that the solve applied (warm start included; a cold
+      // restart or a direct solve reset them with the velocities): taken off, the velocities
+      // are those after the loads, to rounding.
+      apply_accumulated_impulses(manifolds_, bodies_, -1.0);
       std::swap(manifolds_, previous_manifolds_);  // last step's manifolds again, for the warm start
       pair_up();
       build_manifolds();
@@ -278,24 +279,6 @@ bool NativeEngine::outran_reach() {
     outran = true;
   }
   return outran;
-}
-
-void NativeEngine::undo_contact_impulses() {
-  // The accumulated impulses are all that the solve applied (warm start included; a cold
-  // restart or a direct solve reset them together with the velocities): taking them off gives
-  // the velocities after the loads, to rounding.
-  for (const Manifold& m : manifolds_) {
-    const Vec2 t = perp(m.normal);
-    for (int k = 0; k < m.point_count; ++k) {
-      const ManifoldPoint& p = m.points[k];
-      const Vec2 impulse = p.normal_impulse * m.normal + p.tangent_impulse * t;
-      if (impulse == Vec2{}) continue;
-      bodies_.velocity[m.body_a] += bodies_.inv_mass[m.body_a] * impulse;
-      bodies_.angular_velocity[m.body_a] += bodies_.inv_inertia[m.body_a] * cross(p.ra, impulse);
-      bodies_.velocity[m.body_b] -= bodies_.inv_mass[m.body_b] * impulse;
-      bodies_.angular_velocity[m.body_b] -= bodies_.inv_inertia[m.body_b] * cross(p.rb, impulse);
-    }
-  }
 }
 
 void NativeEngine::find_pairs(const Loads* loads) {
@@ -456,7 +439,7 @@ void NativeEngine::solve_islands_directly(double before) {
   // First the normals alone, friction taken off: the sweeps' friction was found against their
   // wrong normals (in a heavy-light chain, tangential impulses of the size of the wrong normal
   // ones), and held it throws light floes sideways.
-  if (!island_solver_.solve(manifolds_, bodies_, /*without_friction=*/true).applied) return;
+  if (!island_solver_.solve(manifolds_, bodies_, /*without_friction=*/true)) return;
   // Then sweeps bring friction back to its law for the exact normals, and the normals are
   // solved again with the friction they leave (the sweeps cannot hold the normals of a
   // heavy-light chain themselves), until the sweeps leave them within the trigger. Last,
@@ -469,7 +452,7 @@ void NativeEngine::solve_islands_directly(double before) {
   for (int pass = 0; pass < 3; ++pass) {
     total_sweeps_ += solve_velocities(island_manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
     if (!island_solver_.select(island_manifolds_, bodies_, trigger, settings_.direct_solve_mass_ratio) ||
-        !island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false).applied)
+        !island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false))
       break;
   }
   clamp_friction(island_manifolds_, bodies_);
