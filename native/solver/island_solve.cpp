@@ -214,7 +214,7 @@ bool IslandSolver::solve_by_descent(std::span<const Manifold> manifolds, BodyArr
   // by the active-set method of Lawson and Hanson (1974, "Solving least squares problems",
   // ch. 23), from Gauss-Seidel's impulses: solve the equalities of the pressing set; where that
   // would make an impulse negative, step only as far as keeps every impulse >= 0 and let go of
-  // those at 0; then take in every point still approaching. Each step lowers the objective, so
+  // those at 0; then take in the point approaching most. Each step lowers the objective, so
   // it does not cycle as pivoting can.
   const std::size_t np = points_.size();
   const double tolerance = 1e-2 * trigger_velocity_;
@@ -240,13 +240,23 @@ bool IslandSolver::solve_by_descent(std::span<const Manifold> manifolds, BodyArr
     for (std::size_t i = 0; i < np; ++i) now[i] = active_[i] ? std::max(normal_[i], 0.0) : 0.0;
     normal_ = now;
     apply_normals(manifolds, s);
-    bool added = false;
+    // One point taken in per round, the one approaching most (Lawson and Hanson's rule: with it
+    // the new point's impulse comes out positive, so the objective falls). Taking in every
+    // approaching point at once cycled where the pressing sets are nearly singular: the 5 m/s
+    // impact, 254 of 523 points pressing, the same sets for 2 000 rounds, and the pack driven
+    // 9 cm into itself by Gauss-Seidel's answer, which was then kept.
+    std::size_t most = np;
+    double most_shortfall = tolerance;
     for (std::size_t i = 0; i < np; ++i)
-      if (!active_[i] && approaching(manifolds, s, i, tolerance)) {
-        active_[i] = 1;
-        added = true;
+      if (!active_[i]) {
+        const double f = shortfall(manifolds[points_[i].manifold], point(manifolds, i), s);
+        if (f > most_shortfall) {
+          most_shortfall = f;
+          most = i;
+        }
       }
-    if (!added) return true;
+    if (most == np) return true;
+    active_[most] = 1;
   }
   return false;
 }

@@ -79,6 +79,7 @@ class NativeEngine final : public Engine {
   std::int64_t cold_restarts_ = 0;
   std::int64_t redetections_ = 0;          // steps whose contacts were found again (outran reach)
   static constexpr int kMaxRedetections = 4;  // a struck floe striking the next, and so on
+  static constexpr int kFrictionRounds = 8;   // cut friction, solve the normals again (drift_in_field: 88 % of solves cut nothing, 99 % within 2 rounds)
   std::int64_t direct_solves_ = 0;    // steps whose islands were solved directly
   std::int64_t direct_reverted_ = 0;  // ... and then given back (they would have made energy)
   std::vector<Vec2> saved_velocity_;
@@ -443,7 +444,12 @@ void NativeEngine::solve_islands_directly(double before) {
   // Then sweeps bring friction back to its law for the exact normals, and the normals are
   // solved again with the friction they leave (the sweeps cannot hold the normals of a
   // heavy-light chain themselves), until the sweeps leave them within the trigger. Last,
-  // friction beyond a fallen normal's cone is cut back to it (island_solve.cpp).
+  // friction beyond a fallen normal's cone is cut back to it, and the normals solved again with
+  // the cut friction held, in turn until nothing is cut (a staggered projection: Kaufman, Sueda,
+  // James and Pai, "Staggered projections for frictional contact in multibody systems", 2008).
+  // Cutting alone undid the normals: a floe wedged between the iceberg and heavy floes was left
+  // approaching at 0.1 m/s after 112 cuts, 18 mm of overlap in the next step (drift_in_field,
+  // field seed 3; 1.4 mm deepest in that run now).
   // The sweeps run on the islands' manifolds alone (the rest stays as Gauss-Seidel left it):
   // copied out, solved, copied back.
   island_index_.assign(island_solver_.island_manifolds().begin(), island_solver_.island_manifolds().end());
@@ -455,7 +461,10 @@ void NativeEngine::solve_islands_directly(double before) {
         !island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false))
       break;
   }
-  clamp_friction(island_manifolds_, bodies_);
+  for (int round = 0; round < kFrictionRounds && clamp_friction(island_manifolds_, bodies_) > 0; ++round)
+    if (!island_solver_.select(island_manifolds_, bodies_, trigger, settings_.direct_solve_mass_ratio) ||
+        !island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false))
+      break;
   for (std::size_t x = 0; x < island_index_.size(); ++x) manifolds_[island_index_[x]] = island_manifolds_[x];
   ++direct_solves_;
   if (!contacts_gain_energy(before)) return;
