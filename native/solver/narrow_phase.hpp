@@ -22,6 +22,9 @@ struct PartGeometry {
 /// polygon is clipped to the reference face's side planes (Sutherland-Hodgman), and every
 /// clipped point closer than `margin` becomes a contact point. After Box2D v2.4's
 /// b2CollidePolygons (Catto, GDC 2007 "Contact manifolds"), with zero skin radius.
+/// Where clipping leaves nothing (the polygons apart, corner beside corner), the one point is the
+/// closest pair of points, its normal along the line joining them (what speculative contact
+/// needs: a floe sliding corner-first onto another's face within the step).
 void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m);
 
 }  // namespace floedem

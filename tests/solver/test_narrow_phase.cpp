@@ -82,3 +82,33 @@ TEST_CASE("normal points from a to b whichever face is the reference", "[narrow]
   CHECK(m.normal.x == Approx(1.0).margin(1e-12));
   CHECK(m.points[0].separation == Approx(-0.01).margin(1e-9));
 }
+
+TEST_CASE("corner beside corner, apart: one point on the closest pair, along the line joining them", "[narrow]") {
+  // b's left edge lies wholly above the end of a's right face (x = 5, y <= 5): clipping to the
+  // face's side planes leaves nothing. The closest points are a's corner (5, 5) and b's corner
+  // (5.02, 5.005); the contact is there, its normal along the line joining them.
+  const Poly a(square(10), {0, 0}, 0.0);
+  const Poly b(square(10), {10.02, 10.005}, 0.0);
+  Manifold m;
+  collide(a.geometry(), b.geometry(), 0.01, 1e-4, m);
+  CHECK(m.point_count == 0);  // beyond the margin
+  collide(a.geometry(), b.geometry(), 0.1, 1e-4, m);
+  REQUIRE(m.point_count == 1);
+  const double d = std::hypot(0.02, 0.005);
+  CHECK(m.points[0].separation == Approx(d).epsilon(1e-12));
+  CHECK(m.normal.x == Approx(0.02 / d).epsilon(1e-12));
+  CHECK(m.normal.y == Approx(0.005 / d).epsilon(1e-12));
+  CHECK(m.points[0].point.x == Approx(5.01).epsilon(1e-12));
+  CHECK(m.points[0].point.y == Approx(5.0025).epsilon(1e-12));
+  // The position solve's plane and point, carried by the bodies, give the same gap.
+  const Vec2 face = (m.reference_is_b ? b.x : a.x).apply(m.local_face_point);
+  const Vec2 q = (m.reference_is_b ? a.x : b.x).apply(m.points[0].local_incident);
+  const Vec2 n_ref = (m.reference_is_b ? b.x : a.x).q.apply(m.local_normal);
+  CHECK(dot(q - face, n_ref) == Approx(d).epsilon(1e-12));
+  // The same pair with the roles swapped: the normal still points from a to b.
+  Manifold swapped;
+  collide(b.geometry(), a.geometry(), 0.1, 1e-4, swapped);
+  REQUIRE(swapped.point_count == 1);
+  CHECK(swapped.normal.x == Approx(-0.02 / d).epsilon(1e-12));
+  CHECK(swapped.points[0].separation == Approx(d).epsilon(1e-12));
+}
