@@ -59,7 +59,8 @@ Provenance field_provenance(const Field& field, const FieldSpec& spec, double de
            {"newton_iterations", static_cast<double>(st.newton_iterations)},
            {"lloyd_steps", static_cast<double>(st.lloyd_steps)},
            {"max_cell_area_error", st.max_cell_area_error},
-           {"floes_short_of_area", static_cast<double>(st.floes_short_of_area)}}};
+           {"floes_short_of_area", static_cast<double>(st.floes_short_of_area)},
+           {"floes_dropped_below_d_min", static_cast<double>(st.floes_dropped_below_d_min)}}};
 }
 
 void write_field_file(const std::string& path, const Field& field, const FieldSpec& spec, double density,

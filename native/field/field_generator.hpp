@@ -77,7 +77,8 @@ struct FieldStats {
   int newton_iterations = 0;          ///< total over all weight solves
   int lloyd_steps = 0;
   double max_cell_area_error = 0.0;   ///< relative, of the last weight solve
-  std::size_t floes_short_of_area = 0;///< floes cut smaller by a keep-out zone (stats only)
+  std::size_t floes_short_of_area = 0;///< floes cut smaller by a keep-out zone, kept (at least d_min)
+  std::size_t floes_dropped_below_d_min = 0;///< cells a keep-out zone cut below a floe of d_min: no floe
 };
 
 struct Field {

@@ -51,6 +51,23 @@ void check_geometry(const FieldSpec& s, const Field& f) {
   REQUIRE_FALSE(hit.has_value());
 }
 
+/// A field of 5 to 60 m floes, 1.16 m thick, round the iceberg of towing_paper.toml and
+/// drift_in_field.toml (its waterline as the keep-out zone).
+FieldSpec round_iceberg(Vec2 origin, double width, double height, double concentration, std::uint64_t seed) {
+  FieldSpec s;
+  s.origin = origin;
+  s.width = width;
+  s.height = height;
+  s.concentration = concentration;
+  s.alpha = 2.0;
+  s.d_min = 5.0;
+  s.d_max = 60.0;
+  s.thickness.value = 1.16;
+  s.seed = seed;
+  s.keep_out = {{{-90, -55}, {-20, -62}, {60, -58}, {92, -20}, {88, 35}, {40, 62}, {5, 40}, {-30, 60}, {-85, 45}, {-95, 0}}};
+  return s;
+}
+
 }  // namespace
 
 TEST_CASE("field: concentration within 0.005 of the target, no overlap, inside the domain", "[field]") {
@@ -163,17 +180,7 @@ TEST_CASE("field: keep-out zones stay free and the concentration holds on the fr
 TEST_CASE("field: a keep-out cut that leaves a sliver gives no floe, never a degenerate one", "[field]") {
   // Regression: the towing case's iceberg in a 600 m x 400 m field (seed 2016) left one cell
   // cleaned to a segment; it was shrunk by 0 / 0 into a NaN floe that crashed the convex partition.
-  FieldSpec s;
-  s.origin = {-150.0, -200.0};
-  s.width = 600.0;
-  s.height = 400.0;
-  s.concentration = 0.5;
-  s.alpha = 2.0;
-  s.d_min = 5.0;
-  s.d_max = 60.0;
-  s.thickness.value = 1.16;
-  s.seed = 2016;
-  s.keep_out = {{{-90, -55}, {-20, -62}, {60, -58}, {92, -20}, {88, 35}, {40, 62}, {5, 40}, {-30, 60}, {-85, 45}, {-95, 0}}};
+  const FieldSpec s = round_iceberg({-150.0, -200.0}, 600.0, 400.0, 0.5, 2016);
   const Field f = generate_field(s);
   CHECK(f.stats.floes_short_of_area >= 1);
   for (const auto& p : f.floes) {
@@ -228,4 +235,15 @@ TEST_CASE("field: bad parameters name the parameter and the allowed range", "[fi
       CHECK(std::string(e.what()).find(b.says) != std::string::npos);
     }
   }
+}
+
+TEST_CASE("field: no floe a keep-out cut leaves smaller than d_min", "[field]") {
+  // drift_in_field's iceberg and field with seed 2 left a 0.6 m fragment (d_min 5 m) at the
+  // iceberg's corner: 289 kg among 5e4 kg floes, squeezed out at 1.5 m/s in the run.
+  const FieldSpec s = round_iceberg({-500.0, -350.0}, 1000.0, 700.0, 0.4, 2);
+  const Field f = generate_field(s);
+  CHECK(f.stats.floes_dropped_below_d_min >= 1);
+  const double smallest = std::numbers::pi / 4.0 * s.d_min * s.d_min;
+  for (const auto& p : f.floes) REQUIRE(signed_area(p) >= smallest * (1.0 - 1e-9));
+  CHECK(std::abs(f.stats.concentration - 0.4) <= 0.005);
 }
