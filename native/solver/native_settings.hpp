@@ -12,7 +12,7 @@ struct NativeSettings {
   double position_correction = 0.2;  ///< fraction of the overlap removed per sweep
   double allowed_penetration = 1e-3; ///< m, overlap left alone (keeps contacts persistent)
   double max_correction = 0.2;       ///< m, largest push of one sweep at one point
-  bool redetect = false;             ///< find the step's contacts again when impulses send a body beyond its reach
+  bool redetect = true;              ///< find the step's contacts again when impulses send a body beyond its reach
   bool direct_solve = true;          ///< heavy-light islands Gauss-Seidel cannot hold get their normals solved directly
   double direct_solve_mass_ratio = 300.0;  ///< ... islands whose heaviest body is at least this times their lightest
 };

@@ -56,6 +56,19 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
     if (boxes[p.a].overlaps(boxes[p.b])) out.push_back(p);
 }
 
+void PairCache::parts_near(const Aabb& box, std::vector<std::int32_t>& out) const {
+  out.clear();
+  if (!grid_.gridded()) {
+    for (std::size_t k = 0; k < fat_.size(); ++k)
+      if (fat_[k].overlaps(box)) out.push_back(static_cast<std::int32_t>(k));
+    return;
+  }
+  grid_.query(box, out);
+  std::erase_if(out, [&](std::int32_t j) { return stale_[j] || !fat_[j].overlaps(box); });  // stale: old grid entry
+  for (const std::int32_t j : stale_list_)
+    if (fat_[j].overlaps(box)) out.push_back(j);
+}
+
 void PairCache::rebuild(std::span<const std::int32_t> body, std::span<const std::uint8_t> fixed) {
   grid_.find_pairs(fat_, body, fixed, candidates_);
   for (const std::int32_t k : stale_list_) stale_[k] = 0;

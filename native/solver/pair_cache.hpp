@@ -26,6 +26,10 @@ class PairCache {
   void find_pairs(std::span<const Aabb> boxes, std::span<const double> margin, std::span<const std::int32_t> body,
                   std::span<const std::uint8_t> fixed, std::vector<PartPair>& out);
 
+  /// Parts whose fat box overlaps `box` (its step box, after find_pairs, lies in its fat box):
+  /// the grid for parts unchanged since the last rebuild, the changed ones directly.
+  void parts_near(const Aabb& box, std::vector<std::int32_t>& out) const;
+
   std::int64_t rebuilds() const { return rebuilds_; }
   std::int64_t refreshed_parts() const { return refreshed_; }  ///< parts given a new fat box, over the run
 

@@ -9,6 +9,7 @@ namespace floedem {
 
 PartSet::PartSet(const Scene& scene) {
   first_.push_back(0);
+  first_part_.push_back(0);
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& b = scene.bodies[i];
     for (const auto& part : b.local_parts) {
@@ -25,6 +26,7 @@ PartSet::PartSet(const Scene& scene) {
       first_.push_back(static_cast<std::int32_t>(local_vertices_.size()));
       radius_.push_back(r);
     }
+    first_part_.push_back(static_cast<std::int32_t>(body_.size()));
   }
   world_vertices_.resize(local_vertices_.size());
   world_normals_.resize(local_normals_.size());

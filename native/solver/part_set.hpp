@@ -21,6 +21,8 @@ class PartSet {
 
   PartGeometry geometry(std::int32_t part, Vec2 position, Rot rotation) const;
   std::span<const std::int32_t> body() const { return body_; }
+  /// A body's parts are parts first_part(b) to first_part(b + 1) - 1 (parts are in body order).
+  std::int32_t first_part(std::int32_t body) const { return first_part_[body]; }
   /// Non-zero for parts of bodies of infinite mass in contacts (fixed or prescribed).
   std::span<const std::uint8_t> immovable() const { return immovable_; }
   /// Largest distance of a vertex of the part from its body's centroid (m).
@@ -31,6 +33,7 @@ class PartSet {
   std::vector<std::int32_t> body_;
   std::vector<std::uint8_t> immovable_;
   std::vector<std::int32_t> first_;  // first vertex of part k; part k ends at first_[k + 1]
+  std::vector<std::int32_t> first_part_;  // first part of body b; its parts end at first_part_[b + 1]
   std::vector<Vec2> local_vertices_, local_normals_;
   std::vector<Vec2> world_vertices_, world_normals_;
   std::vector<double> radius_;
