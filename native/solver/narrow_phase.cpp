@@ -63,8 +63,7 @@ ClosestPoints closest_points(const ConvexView& ref, const ConvexView& inc) {
 
 void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip, double margin, Manifold& m) {
   const ClosestPoints c = closest_points(ref.world, inc.world);
-  // Overlapping (or touching, where the direction is undefined) corner to corner: left to the
-  // steps either side, as before; apart but beyond reach: no contact.
+  // Touching (the direction undefined) or beyond reach: no contact.
   if (!(c.distance > 1e-9) || c.distance > margin) return;
   const Vec2 n = (1.0 / c.distance) * (c.on_inc - c.on_ref);  // from the reference part to the incident one
   m.normal = flip ? -n : n;
@@ -131,7 +130,9 @@ void collide(const PartGeometry& a, const PartGeometry& b, double margin, double
     // step before); the speculative contact is then the closest pair of points, with its
     // direction as the normal: the planes through them perpendicular to it separate the
     // polygons (both convex), so holding that gap at >= 0 keeps them apart to first order.
-    corner_contact(ref, inc, flip, margin, m);
+    // Overlapping so (the separating axes say so), no contact, as before: the vertex-edge
+    // distances do not measure an overlap.
+    if (std::max(sa.separation, sb.separation) > 0.0) corner_contact(ref, inc, flip, margin, m);
     return;
   }
 

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <random>
+
 #include "solver/narrow_phase.hpp"
 #include "support.hpp"
 
@@ -111,4 +113,37 @@ TEST_CASE("corner beside corner, apart: one point on the closest pair, along the
   REQUIRE(swapped.point_count == 1);
   CHECK(swapped.normal.x == Approx(-0.02 / d).epsilon(1e-12));
   CHECK(swapped.points[0].separation == Approx(d).epsilon(1e-12));
+}
+
+TEST_CASE("corner contacts: only for polygons apart, on a plane pair that separates them", "[narrow]") {
+  // Random boxes (aspect up to 1:50, any angle) placed about each other's corners: wherever the
+  // narrow phase makes a corner contact, the separating axes must say the polygons are apart,
+  // its gap must be at least theirs (it is the true distance, they a lower bound), and the
+  // planes through its two points, normal to it, must have each polygon on its own side.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int corner_contacts = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double wa = 0.2 + 10.0 * u(rng), ha = wa / (1.0 + 49.0 * u(rng));
+    const double wb = 0.2 + 10.0 * u(rng), hb = wb / (1.0 + 49.0 * u(rng));
+    const Poly a(test::box({0, 0}, wa, ha), {0, 0}, 2.0 * M_PI * u(rng));
+    const double d = 0.5 * (std::hypot(wa, ha) + std::hypot(wb, hb)) * (0.9 + 0.2 * u(rng));
+    const double phi = 2.0 * M_PI * u(rng);
+    const Poly b(test::box({0, 0}, wb, hb), {d * std::cos(phi), d * std::sin(phi)}, 2.0 * M_PI * u(rng));
+    Manifold m;
+    collide(a.geometry(), b.geometry(), 1.0, 1e-4, m);
+    if (m.point_count != 1 || !(m.points[0].id & 0x40000000u)) continue;
+    ++corner_contacts;
+    const ConvexView va{a.world.data(), a.world_n.data(), 4}, vb{b.world.data(), b.world_n.data(), 4};
+    const double sat = std::max(max_face_separation(va, vb).separation, max_face_separation(vb, va).separation);
+    REQUIRE(sat > 0.0);
+    const ManifoldPoint& p = m.points[0];
+    CHECK(p.separation >= sat - 1e-12);
+    CHECK(length(m.normal) == Approx(1.0).epsilon(1e-12));
+    // m.normal points from a to b; the contact point is midway between the closest points.
+    const Vec2 on_a = p.point - 0.5 * p.separation * m.normal, on_b = p.point + 0.5 * p.separation * m.normal;
+    for (const Vec2 v : a.world) CHECK(dot(v - on_a, m.normal) <= 1e-9);
+    for (const Vec2 v : b.world) CHECK(dot(v - on_b, m.normal) >= -1e-9);
+  }
+  CHECK(corner_contacts > 100);  // the property was put to the test
 }
