@@ -48,6 +48,9 @@ class NativeEngine final : public Engine {
   void integrate();
   void record();
   PartGeometry part_geometry(std::int32_t k) const;
+  double reach_of_part(std::int32_t k) const;
+  Aabb reach_box(std::int32_t k, double reach) const;
+  void collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m) const;
   void solve_contacts();
   void solve_islands_directly(double energy_before);
   bool contacts_gain_energy(double energy_before) const;
@@ -300,16 +303,8 @@ bool NativeEngine::meets_unseen_contact() {
   // overlap at the velocities the solve left (gap + dt u_n), calls for the step to be solved
   // again. The rest cost a box query and a narrow phase each (towing: most floes the iceberg
   // strikes outrun the reach of a floe at rest, and meet nothing new within the step).
-  auto reach = [&](std::int32_t k) {
-    const std::int32_t b = parts_.body()[k];
-    return linear_reach_[b] + angular_reach_[b] * parts_.radius(k);
-  };
   const double slop = 0.5 * settings_.allowed_penetration;
-  const double flip_tolerance = 0.1 * settings_.allowed_penetration;
-  auto grown = [&](std::int32_t k) {
-    const double r = reach(k) + slop;
-    return Aabb{parts_.boxes()[k].lo - Vec2{r, r}, parts_.boxes()[k].hi + Vec2{r, r}};
-  };
+  auto grown = [&](std::int32_t k) { return reach_box(k, reach_of_part(k)); };
   bool unseen = false;
   Manifold probe;
   for (std::size_t x = 0; x < outran_list_.size() && !unseen; ++x) {
@@ -321,8 +316,7 @@ bool NativeEngine::meets_unseen_contact() {
         const std::int32_t a = parts_.body()[std::min(j, k)], b = parts_.body()[std::max(j, k)];
         if (a == b || (parts_.immovable()[j] && parts_.immovable()[k]) || !grown(j).overlaps(box)) continue;
         const PartPair pair{std::min(j, k), std::max(j, k)};
-        collide(part_geometry(pair.a), part_geometry(pair.b), reach(j) + reach(k) + settings_.allowed_penetration,
-                flip_tolerance, probe);
+        collide_parts(pair, reach_of_part(pair.a), reach_of_part(pair.b), probe);
         if (probe.point_count == 0) continue;
         const auto held = std::lower_bound(manifolds_.begin(), manifolds_.end(), pair, [](const Manifold& m, PartPair p) {
           return PartPair{m.part_a, m.part_b} < p;
@@ -367,15 +361,31 @@ void NativeEngine::find_pairs(const Loads* loads) {
 void NativeEngine::pair_up() {
   const std::size_t np = parts_.size();
   for (std::size_t k = 0; k < np; ++k) {
-    const std::int32_t b = parts_.body()[k];
-    part_reach_[k] = linear_reach_[b] + angular_reach_[b] * parts_.radius(static_cast<std::int32_t>(k));
-    const double fat = part_reach_[k] + 0.5 * settings_.allowed_penetration;
-    part_boxes_[k] = {parts_.boxes()[k].lo - Vec2{fat, fat}, parts_.boxes()[k].hi + Vec2{fat, fat}};
+    part_reach_[k] = reach_of_part(static_cast<std::int32_t>(k));
+    part_boxes_[k] = reach_box(static_cast<std::int32_t>(k), part_reach_[k]);
     // A part that leaves its fat box gets room for about four steps at its present reach and a
     // tenth of its size besides (so that a floe at rest, or creeping, keeps its box for long).
     part_margin_[k] = 4.0 * part_reach_[k] + 0.1 * parts_.radius(static_cast<std::int32_t>(k));
   }
   pair_cache_.find_pairs(part_boxes_, part_margin_, parts_.body(), parts_.immovable(), pairs_);
+}
+
+double NativeEngine::reach_of_part(std::int32_t k) const {
+  const std::int32_t b = parts_.body()[k];
+  return linear_reach_[b] + angular_reach_[b] * parts_.radius(k);
+}
+
+Aabb NativeEngine::reach_box(std::int32_t k, double reach) const {
+  // The part's bounds grown by its reach and half the allowed overlap: the pairs' test.
+  const double fat = reach + 0.5 * settings_.allowed_penetration;
+  return {parts_.boxes()[k].lo - Vec2{fat, fat}, parts_.boxes()[k].hi + Vec2{fat, fat}};
+}
+
+void NativeEngine::collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m) const {
+  // Contacts within both parts' reach this step (speculative), plus the allowed overlap; the
+  // reference face kept unless the other is better by a tenth of it.
+  collide(part_geometry(pair.a), part_geometry(pair.b), reach_a + reach_b + settings_.allowed_penetration,
+          0.1 * settings_.allowed_penetration, m);
 }
 
 PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
@@ -388,7 +398,6 @@ void NativeEngine::build_manifolds() {
   manifolds_.clear();
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
-  const double flip_tolerance = 0.1 * settings_.allowed_penetration;
   narrow_.resize(pairs_.size());
   thread_pool().for_blocks(pairs_.size(), 512, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
@@ -403,8 +412,7 @@ void NativeEngine::build_manifolds() {
       m.body_b = parts_.body()[pair.b];
       m.friction = contact_.friction;
       m.restitution = contact_.restitution;
-      const double margin = part_reach_[pair.a] + part_reach_[pair.b] + settings_.allowed_penetration;
-      collide(part_geometry(pair.a), part_geometry(pair.b), margin, flip_tolerance, m);
+      collide_parts(pair, part_reach_[pair.a], part_reach_[pair.b], m);
     }
   });
   std::size_t old = 0;  // both lists are sorted by (part_a, part_b): a merge carries impulses over
@@ -518,16 +526,17 @@ void NativeEngine::solve_islands_directly(double before) {
   island_index_.assign(island_solver_.island_manifolds().begin(), island_solver_.island_manifolds().end());
   island_manifolds_.clear();
   for (const std::int32_t k : island_index_) island_manifolds_.push_back(manifolds_[k]);
+  // The normals again with friction held, where a point is still left beyond the trigger.
+  auto solve_normals_again = [&] {
+    return island_solver_.select(island_manifolds_, bodies_, trigger, settings_.direct_solve_mass_ratio) &&
+           island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false);
+  };
   for (int pass = 0; pass < 3; ++pass) {
     total_sweeps_ += solve_velocities(island_manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
-    if (!island_solver_.select(island_manifolds_, bodies_, trigger, settings_.direct_solve_mass_ratio) ||
-        !island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false))
-      break;
+    if (!solve_normals_again()) break;
   }
   for (int round = 0; round < kFrictionRounds && clamp_friction(island_manifolds_, bodies_) > 0; ++round)
-    if (!island_solver_.select(island_manifolds_, bodies_, trigger, settings_.direct_solve_mass_ratio) ||
-        !island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false))
-      break;
+    if (!solve_normals_again()) break;
   for (std::size_t x = 0; x < island_index_.size(); ++x) manifolds_[island_index_[x]] = island_manifolds_[x];
   ++direct_solves_;
   if (!contacts_gain_energy(before)) return;
