@@ -102,13 +102,63 @@ void apply_accumulated_impulses(std::span<const Manifold> manifolds, BodyArrays&
   }
 }
 
-int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, int max_iterations, double tolerance) {
+// Acceleration (Silcowitz, Niebe and Erleben 2010, "A nonsmooth nonlinear conjugate gradient
+// method for interactive contact force problems", The Visual Computer 26(6-8), alg. 2): a sweep
+// is x_{k+1} = PGS(x_k); its change r_{k+1} = x_{k+1} - x_k is minus the gradient of the
+// nonsmooth merit function, and the Fletcher-Reeves step
+//
+//   beta = |r_{k+1}|^2 / |r_k|^2,   x_{k+1} += beta p_k,   p_{k+1} = beta p_k + r_{k+1}
+//
+// follows (p_1 = r_1; beta > 1, the merit not falling, restarts with p = 0). Gauss-Seidel hands a
+// load on by one contact per sweep, so a pressed pack N floes deep needs of order N^2 sweeps;
+// the conjugate directions carry it across the pack in of order N (measured: a 95 % jam at
+// dt 0.5 s, 50 sweeps left 34 mm of overlap; accelerated, see the stress suite). The sweep's
+// local solve removes a point's own impulse before solving it, so an iterate the step left
+// outside the cone (P_n < 0 or |P_t| > mu P_n) is brought back by the next sweep; the solve
+// always ends on a sweep, never on a step, so its impulses keep their laws.
+//
+// Extra sweeps: a sweep limit alone leaves a pressed pack closing at whatever speed the last
+// sweep left (the jam at dt 0.5 s: 0.04 m/s, 20 mm a step, more than the position projection
+// takes back). Past `iterations`, the sweeps go on while a point approaches faster than its
+// target by more than `closing_speed` (the engine's: allowed_penetration / dt, the overlap the
+// step may add), looked at every kCheckEvery sweeps, up to `extra_iterations` more; once a pack
+// holds, the warm start keeps it within the ordinary limit.
+namespace {
+constexpr int kCheckEvery = 10;
+}
+
+double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& s) {
+  double worst = 0.0;
+  for (const Manifold& m : manifolds)
+    for (int k = 0; k < m.point_count; ++k) {
+      const ManifoldPoint& p = m.points[k];
+      worst = std::max(worst, p.target_velocity - dot(relative_velocity(s, m.body_a, m.body_b, p.ra, p.rb), m.normal));
+    }
+  return worst;
+}
+
+int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits,
+                     SweepMomentum* momentum) {
+  if (momentum) {
+    // Room for half as many manifolds again: no allocation each time a pack gains a contact.
+    const std::size_t n = 4 * manifolds.size();
+    if (momentum->direction.capacity() < n) {
+      momentum->change.reserve(n + n / 2);
+      momentum->direction.reserve(n + n / 2);
+    }
+    momentum->change.resize(n);
+    momentum->direction.assign(n, 0.0);
+  }
+  double previous_size = 0.0;  // |r_k|^2; 0 before the first sweep
+  int max_iterations = limits.iterations;
   int sweep = 0;
   while (sweep < max_iterations) {
     ++sweep;
     double largest_change = 0.0;
     double largest_impulse = 0.0;
-    for (Manifold& m : manifolds) {
+    double size = 0.0;  // |r_{k+1}|^2
+    for (std::size_t mi = 0; mi < manifolds.size(); ++mi) {
+      Manifold& m = manifolds[mi];
       const Vec2 n = m.normal;
       const Vec2 t = perp(n);
       for (int k = 0; k < m.point_count; ++k) {
@@ -125,9 +175,42 @@ int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, int max_itera
         p.tangent_impulse = r.tangent;
         largest_change = std::max(largest_change, std::abs(dpn) + std::abs(dpt));
         largest_impulse = std::max(largest_impulse, r.normal + std::abs(r.tangent));
+        if (momentum) {
+          momentum->change[4 * mi + 2 * k] = dpn;
+          momentum->change[4 * mi + 2 * k + 1] = dpt;
+          size += dpn * dpn + dpt * dpt;
+        }
       }
     }
-    if (largest_change <= tolerance * largest_impulse) break;
+    if (largest_change <= limits.tolerance * largest_impulse) break;
+    if (sweep >= limits.iterations && (sweep - limits.iterations) % kCheckEvery == 0 && limits.extra_iterations > 0) {
+      if (largest_shortfall(manifolds, s) <= limits.closing_speed) break;
+      max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
+    }
+    if (!momentum || sweep == max_iterations) continue;
+    std::vector<double>& p = momentum->direction;
+    const std::vector<double>& r = momentum->change;
+    if (previous_size > 0.0 && size > previous_size) {
+      std::fill(p.begin(), p.end(), 0.0);  // the merit rose: restart
+    } else {
+      const double beta = previous_size > 0.0 ? size / previous_size : 0.0;
+      for (std::size_t mi = 0; mi < manifolds.size(); ++mi) {
+        Manifold& m = manifolds[mi];
+        for (int k = 0; k < m.point_count; ++k) {
+          const std::size_t i = 4 * mi + 2 * k;
+          const double sn = beta * p[i], st = beta * p[i + 1];
+          if (sn != 0.0 || st != 0.0) {
+            ManifoldPoint& q = m.points[k];
+            apply_impulse(s, m, q, sn * m.normal + st * perp(m.normal));
+            q.normal_impulse += sn;
+            q.tangent_impulse += st;
+          }
+          p[i] = sn + r[i];
+          p[i + 1] = st + r[i + 1];
+        }
+      }
+    }
+    previous_size = size;
   }
   return sweep;
 }

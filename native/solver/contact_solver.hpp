@@ -42,9 +42,29 @@ inline void warm_start(std::span<const Manifold> manifolds, BodyArrays& bodies) 
   apply_accumulated_impulses(manifolds, bodies, 1.0);
 }
 
+/// Per-point work arrays of the accelerated sweeps (kept by the caller: no allocation per step).
+struct SweepMomentum {
+  std::vector<double> change;     ///< per point (n, t): the impulse change of the last sweep
+  std::vector<double> direction;  ///< per point (n, t): the conjugate direction p
+};
+
+/// How long the sweeps go on.
+struct SweepLimits {
+  int iterations = 50;         ///< sweeps made at most, unless a point is left closing (below)
+  double tolerance = 1e-10;    ///< stop once no impulse changes by more than this times the largest
+  int extra_iterations = 0;    ///< more sweeps, made only while ...
+  double closing_speed = 0.0;  ///< ... a point approaches faster than its target by more than this (m/s)
+};
+
 /// Gauss-Seidel sweeps until the largest impulse change is below tolerance times the largest
-/// impulse, or max_iterations. Returns the number of sweeps made.
-int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, int max_iterations, double tolerance);
+/// impulse, or the limits' sweeps are spent. With `momentum`, each sweep but the last is
+/// followed by the nonsmooth nonlinear conjugate gradient step (see contact_solver.cpp).
+/// Returns the number of sweeps made.
+int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, const SweepLimits& limits,
+                     SweepMomentum* momentum = nullptr);
+
+/// The largest amount by which a point approaches faster than its target (m/s, >= 0).
+double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& bodies);
 
 /// Cuts every friction impulse back to its cone |P_t| <= mu P_n (after the normals changed),
 /// applying the difference to the bodies. Returns how many were cut.

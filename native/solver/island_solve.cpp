@@ -89,11 +89,8 @@ bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays&
                           double mass_ratio) {
   trigger_velocity_ = trigger_velocity;
   // 1. Is there a point left approaching beyond its target by more than the trigger?
-  double worst = 0.0;
-  for (const Manifold& m : manifolds)
-    for (int k = 0; k < m.point_count; ++k) worst = std::max(worst, shortfall(m, m.points[k], s));
   points_.clear();
-  if (worst <= trigger_velocity) return false;
+  if (largest_shortfall(manifolds, s) <= trigger_velocity) return false;
 
   // 2. Islands (union-find over moving bodies); the points of those holding such a point whose
   // heaviest body is at least mass_ratio times its lightest.

@@ -95,6 +95,13 @@ class NativeEngine final : public Engine {
   std::vector<std::int32_t> island_index_;  // the manifolds of the islands solved directly
   std::vector<Manifold> island_manifolds_;  // ... copied out for their sweeps
   IslandSolver island_solver_;
+  SweepMomentum momentum_;  // the accelerated sweeps' work arrays
+  SweepMomentum* momentum() { return settings_.accelerate ? &momentum_ : nullptr; }
+  /// The sweeps' limits: extra sweeps while a point would close by more than the allowed overlap within the step.
+  SweepLimits sweep_limits() const {
+    return {settings_.velocity_iterations, settings_.tolerance, settings_.extra_iterations,
+            settings_.allowed_penetration / dt_};
+  }
 };
 
 NativeEngine::NativeEngine(const Scene& scene)
@@ -143,6 +150,8 @@ EngineInfo NativeEngine::info() const {
   i.version = "floedem";
   i.settings = {
       {"velocity_iterations", std::to_string(settings_.velocity_iterations)},
+      {"extra_iterations", std::to_string(settings_.extra_iterations)},
+      {"accelerate", settings_.accelerate ? "true" : "false"},
       {"tolerance", setting_text(settings_.tolerance)},
       {"warm_start", settings_.warm_start ? "true" : "false"},
       {"position_iterations", std::to_string(settings_.position_iterations)},
@@ -450,30 +459,29 @@ void NativeEngine::build_manifolds() {
 }
 
 void NativeEngine::solve_contacts() {
-  const double before = settings_.warm_start || heavy_light_ ? contact_kinetic_energy() : 0.0;
-  int sweeps = 0;
-  if (!settings_.warm_start) {
-    sweeps = solve_velocities(manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
-  } else {
-    // Warm starting applies last step's impulses before the sweeps. When the sweep limit stops
-    // the solve short of convergence (long pressed chains), what remains of them can raise the
-    // kinetic energy. Gauss-Seidel from zero impulses cannot: with a non-positive target each
-    // local update moves the velocity to the constraint set along M^-1 J^T, which never raises
-    // 1/2 v'Mv (a projection in the metric of M). So a step whose contact impulses would add
-    // kinetic energy is solved again from zero (contacts_gain_energy: the test).
+  // Gauss-Seidel from zero impulses cannot raise the kinetic energy: with a non-positive target
+  // each local update moves the velocity to the constraint set along M^-1 J^T, which never
+  // raises 1/2 v'Mv (a projection in the metric of M). Warm starting (last step's impulses
+  // applied before the sweeps) and the conjugate-gradient steps leave that argument: when the
+  // sweep limit stops the solve short of convergence (long pressed chains), what remains of the
+  // warm start, or of a step, can raise it. So a step whose contact impulses would add kinetic
+  // energy is solved again from zero with plain sweeps (contacts_gain_energy: the test).
+  const bool checked = settings_.warm_start || settings_.accelerate;
+  const double before = checked || heavy_light_ ? contact_kinetic_energy() : 0.0;
+  if (checked) {
     saved_velocity_ = bodies_.velocity;
     saved_angular_velocity_ = bodies_.angular_velocity;
-    warm_start(manifolds_, bodies_);
-    sweeps = solve_velocities(manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
-    if (contacts_gain_energy(before)) {
-      total_sweeps_ += sweeps;
-      bodies_.velocity = saved_velocity_;
-      bodies_.angular_velocity = saved_angular_velocity_;
-      for (Manifold& m : manifolds_)
-        for (int k = 0; k < m.point_count; ++k) m.points[k].normal_impulse = m.points[k].tangent_impulse = 0.0;
-      sweeps = solve_velocities(manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
-      ++cold_restarts_;
-    }
+  }
+  if (settings_.warm_start) warm_start(manifolds_, bodies_);
+  int sweeps = solve_velocities(manifolds_, bodies_, sweep_limits(), momentum());
+  if (checked && contacts_gain_energy(before)) {
+    total_sweeps_ += sweeps;
+    bodies_.velocity = saved_velocity_;
+    bodies_.angular_velocity = saved_angular_velocity_;
+    for (Manifold& m : manifolds_)
+      for (int k = 0; k < m.point_count; ++k) m.points[k].normal_impulse = m.points[k].tangent_impulse = 0.0;
+    sweeps = solve_velocities(manifolds_, bodies_, sweep_limits());  // plain sweeps: no energy made
+    ++cold_restarts_;
   }
   total_sweeps_ += sweeps;
   // Out of sweeps: an island Gauss-Seidel cannot hold (heavy-light chains) gets its normal
@@ -532,7 +540,7 @@ void NativeEngine::solve_islands_directly(double before) {
            island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false);
   };
   for (int pass = 0; pass < 3; ++pass) {
-    total_sweeps_ += solve_velocities(island_manifolds_, bodies_, settings_.velocity_iterations, settings_.tolerance);
+    total_sweeps_ += solve_velocities(island_manifolds_, bodies_, {settings_.velocity_iterations, settings_.tolerance});
     if (!solve_normals_again()) break;
   }
   for (int round = 0; round < kFrictionRounds && clamp_friction(island_manifolds_, bodies_) > 0; ++round)

@@ -12,8 +12,10 @@ NativeSettings read_native_settings(const Scene& scene) {
   if (it == scene.engine_settings.end()) return s;
   TableReader r(it->second, scene.source_path, "engine.native");
   s.velocity_iterations = static_cast<int>(r.integer("velocity_iterations", s.velocity_iterations, 1, 1'000'000));
+  s.extra_iterations = static_cast<int>(r.integer("extra_iterations", s.extra_iterations, 0, 1'000'000));
   s.tolerance = r.real("tolerance", s.tolerance, Range{0.0, 1.0, false, true});
   s.warm_start = r.boolean("warm_start", s.warm_start);
+  s.accelerate = r.boolean("accelerate", s.accelerate);
   s.position_iterations = static_cast<int>(r.integer("position_iterations", s.position_iterations, 0, 1000));
   s.position_correction = r.real("position_correction", s.position_correction, Range{0.0, 1.0, true, false});
   s.allowed_penetration = r.real("allowed_penetration", s.allowed_penetration, Range::non_negative());

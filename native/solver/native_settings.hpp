@@ -5,9 +5,11 @@ namespace floedem {
 
 /// [engine.native] settings; defaults and reasons in scenarios/README.md.
 struct NativeSettings {
-  int velocity_iterations = 50;      ///< most Gauss-Seidel sweeps per step
+  int velocity_iterations = 50;      ///< most Gauss-Seidel sweeps per step, unless ...
+  int extra_iterations = 450;        ///< ... a point is left closing by more than allowed_penetration in the step: up to this many more
   double tolerance = 1e-10;          ///< stop sweeping when max |dP| <= tolerance * max |P|
   bool warm_start = true;            ///< start from last step's resting impulses
+  bool accelerate = true;            ///< conjugate-gradient step after each sweep (NNCG)
   int position_iterations = 4;       ///< position-projection sweeps per step (0: none)
   double position_correction = 0.2;  ///< fraction of the overlap removed per sweep
   double allowed_penetration = 1e-3; ///< m, overlap left alone (keeps contacts persistent)

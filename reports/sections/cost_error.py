@@ -29,7 +29,7 @@ import numpy as np
 
 from report_runner import Run
 from sections import towing
-from sections.speed import ITERATIONS_KEY, read_row
+from sections.speed import iterations, read_row
 
 CORIOLIS_OMEGA = 7.2921e-5
 RESOLUTION = {"impact": 1e-9, "drift": 1e-3}   # towing: the reference's standard error, relative
@@ -65,7 +65,7 @@ def plan(ctx):
         for it, scale in c["impact"]:
             dt = IMPACT_DT * scale
             runs += pair(f"ce_impact_{e}_it{it}_dt{dt:.3g}", os.path.join(ctx.scenarios, IMPACT), e,
-                         [f"run.dt={dt!r}", f"engine.{e}.{ITERATIONS_KEY[e]}={it}"], 0.1,
+                         [f"run.dt={dt!r}"] + iterations(e, it), 0.1,
                          dict(case="impact", iterations=it, dt=dt))
         for dt in c["drift"]:
             runs += pair(f"ce_drift_{e}_dt{dt:g}", os.path.join(ctx.scenarios, DRIFT), e,
@@ -78,7 +78,7 @@ def plan(ctx):
     for e in ctx.engines:
         for dt, it in t["points"]:
             runs += pair(f"ce_towing_{e}_it{it}_dt{dt:g}", scenario, e,
-                         base + [f"run.dt={dt!r}", f"engine.{e}.{ITERATIONS_KEY[e]}={it}"], t["window"],
+                         base + [f"run.dt={dt!r}"] + iterations(e, it), t["window"],
                          dict(case="towing", iterations=it, dt=dt), cost=t["duration"] / dt * 1e-3)
     dt, it = t["reference"]
     runs.append(Run("ce_towing_reference", scenario, "native",

@@ -86,3 +86,52 @@ TEST_CASE("stress: forcing makes the energy check void, and says so with NaN", "
   const RunSummary r = run_stress("slivers.toml", {"run.duration=1"});
   CHECK(std::isnan(r.max_kinetic_energy));
 }
+
+TEST_CASE("stress: a jam at dt 0.5 s holds on native; with plain sweeps it does not", "[stress]") {
+  // 95 % ice pressed by wind and current against a grounded iceberg and three walls: the walls'
+  // reaction crosses a pack some 30 floes deep. 50 plain Gauss-Seidel sweeps leave it closing at
+  // centimetres a step (34 mm deep at t = 30 s); the conjugate-gradient steps and the extra
+  // sweeps (on by default) hold it within 1 % of the 1 m floes.
+  const std::vector<std::string> jam = {"run.duration=120.0", "run.output_every=1000000"};
+  const RunSummary r = run_stress("jam.toml", jam);
+  CHECK(r.max_penetration < 0.01 * 1.0);
+  CHECK(r.contact_work <= 0.0);
+  CHECK(r.max_relative_energy_gain <= 1e-6);
+  std::vector<std::string> plain = jam;
+  plain.insert(plain.end(), {"engine.native.accelerate=false", "engine.native.extra_iterations=0"});
+  CHECK(run_stress("jam.toml", plain).max_penetration > 0.01 * 1.0);
+}
+
+TEST_CASE("stress: a resting column carries its drag to the wall, steady to 0.1 %", "[stress]") {
+  // Thirty floes pressed end to end against a wall by wind and current. Once closed up they are
+  // at rest, and each step the wall's impulse must be the column's drag impulse for that step
+  // (the forcing's loads summed over the floes; the banks carry nothing, the floes being
+  // aligned with them): 0.1 % is the bound of a resting contact's load (test_resting.cpp),
+  // far above round-off and far below any jitter or creep worth the name.
+  const Scene s = load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/stress/pressed_column.toml");
+  auto e = test::native(s);
+  Forcing forcing(s);
+  const double dt = s.run.dt;
+  double worst = 0.0, overlap = 0.0;
+  int measured = 0;
+  for (int k = 0; k < 6000; ++k) {
+    const Loads* loads = forcing.evaluate(e->state(), k * dt);
+    double drag = 0.0;  // N, along the wind (+x), on the floes
+    for (std::size_t i = 3; i < s.bodies.size(); ++i) drag += loads->force[i].x;
+    e->step(loads);
+    double wall = 0.0;  // N, along +x, on the wall (body 0)
+    for (const ContactRecord& c : e->contacts()) {
+      overlap = std::max(overlap, -c.separation);
+      const double px = c.normal_impulse * c.normal.x - c.tangent_impulse * c.normal.y;
+      if (c.body_b == 0) wall += px / dt;
+      if (c.body_a == 0) wall -= px / dt;
+    }
+    if (k >= 5000) {  // the last 100 s
+      worst = std::max(worst, std::abs(wall - drag) / drag);
+      ++measured;
+    }
+  }
+  CHECK(measured == 1000);
+  CHECK(worst <= 1e-3);
+  CHECK(overlap < 0.01);
+}
