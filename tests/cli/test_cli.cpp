@@ -114,7 +114,7 @@ TEST_CASE("cli: help lists the commands and options", "[cli]") {
   for (const char* opt : {"--engine", "--out", "--set"}) CHECK(r.output.find(opt) != std::string::npos);
 }
 
-TEST_CASE("cli: floedem bench prints and appends one CSV row; bad input exits 2", "[cli]") {
+TEST_CASE("cli: floedem bench prints and appends one CSV row, bad input exits 2", "[cli]") {
   // Not a timing test: what the row holds (its columns and the achieved figures), not how fast.
   const fs::path d = dir_for("bench");
   const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/head_on.toml";

@@ -54,7 +54,7 @@ TEST_CASE("stress: the mass-ratio ladder 1e3 to 1e8 against a wall holds on nati
   }
 }
 
-TEST_CASE("stress: a 5 m/s impact of 1e6 kg on the floes holds on native; without redetect it does not", "[stress]") {
+TEST_CASE("stress: a 5 m/s impact of 1e6 kg on the floes holds on native, without redetect it does not", "[stress]") {
   // The struck floes cross their 5 cm gaps within one 0.01 s step: redetect (on by default)
   // finds the contacts they meet at the widened reach and solves the step again, the heavy-light
   // chain directly: 0.0007 mm measured; without it the first crossing leaves 4.9 mm.
@@ -87,7 +87,7 @@ TEST_CASE("stress: forcing makes the energy check void, and says so with NaN", "
   CHECK(std::isnan(r.max_kinetic_energy));
 }
 
-TEST_CASE("stress: a jam at dt 0.5 s holds on native; with plain sweeps it does not", "[stress]") {
+TEST_CASE("stress: a jam at dt 0.5 s holds on native, with plain sweeps it does not", "[stress]") {
   // 95 % ice pressed by wind and current against a grounded iceberg and three walls: the walls'
   // reaction crosses a pack some 30 floes deep. 50 plain Gauss-Seidel sweeps leave it closing at
   // centimetres a step (34 mm deep at t = 30 s); the conjugate-gradient steps and the extra
