@@ -7,7 +7,7 @@ written all the same), 4 when a run failed (no report written).
 
 `floedem report [--quick] [--out DIR]` runs this (the README's main job).
 
-usage: report.py [--floedem build/floedem] [--out results/report] [--quick] [--jobs N]
+usage: report.py [--floedem build/floedem] [--out results/report] [--quick] [--jobs N] [--only S,...]
 """
 import argparse
 import datetime
@@ -67,7 +67,16 @@ def main():
     ap.add_argument("--quick", action="store_true",
                     help="the same sections on smaller and shorter cases (the CI cross-check, a few minutes)")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time (default: the cores)")
+    names = [s.__name__.split(".")[-1] for s in SECTIONS]
+    ap.add_argument("--only", default="",
+                    help=f"a partial report of these sections alone, comma-separated ({', '.join(names)})")
     a = ap.parse_args()
+    only = [x for x in a.only.split(",") if x]
+    unknown = [x for x in only if x not in names]
+    if unknown:
+        print(f"report: --only: no section {', '.join(unknown)} (sections: {', '.join(names)})", file=sys.stderr)
+        return 2
+    sections = [s for s, n in zip(SECTIONS, names) if not only or n in only]
     start = time.monotonic()
     commit = git_commit()   # now: the tree the runs are made from
     version = floedem_text(a.floedem, "--version").strip()
@@ -82,7 +91,7 @@ def main():
         os.remove(report)
 
     seen = {}
-    for section in SECTIONS:
+    for section in sections:
         for r in section.plan(ctx):
             if r.tag in seen:
                 if seen[r.tag].command("x") != r.command("x"):
@@ -103,14 +112,16 @@ def main():
     run_seconds = time.monotonic() - start
 
     body, fails = [], []
-    for section in SECTIONS:
+    for section in sections:
         md, f = section.write(ctx)
         body += md
         fails += f
     total = time.monotonic() - start
-    head = [f"# floedem cross-engine report{' (--quick)' if a.quick else ''}", "",
+    flags = (" --quick" if a.quick else "") + (f" --only {','.join(only)}" if only else "")
+    head = [f"# floedem cross-engine report{' (--quick)' if a.quick else ''}"
+            f"{' (sections: ' + ', '.join(only) + ')' if only else ''}", "",
             f"Written {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC by `floedem report"
-            f"{' --quick' if a.quick else ''}` ({version}, source commit {commit}) on {platform.node()} "
+            f"{flags}` ({version}, source commit {commit}) on {platform.node()} "
             f"({os.cpu_count()} cores, {a.jobs} runs at a time): {len(ctx.all_runs)} runs in {run_seconds:.0f} s, "
             f"{total:.0f} s in all. Every table and figure below comes from the HDF5 files of those runs, in "
             "`runs/` (each table names its files); none is typed or kept from an earlier report.", "",

@@ -90,11 +90,13 @@ int main(int argc, char** argv) {
   std::string report_out = "results/report";
   bool report_quick = false;
   int report_jobs = 0;
+  std::string report_only;
   CLI::App* report = app.add_subcommand(
       "report", "run the scenario suite on every engine and write DIR/REPORT.md with its figures (reports/report.py)");
   report->add_option("--out,-o", report_out, "report directory (its fig/ and runs/ are replaced)")->capture_default_str();
   report->add_flag("--quick", report_quick,
                    "the same sections on smaller, shorter cases (the CI cross-check; a few minutes on 2 cores)");
+  report->add_option("--only", report_only, "a partial report of these sections alone, comma-separated (impacts, towing, field, channel, stress, speed, cost_error, engines)");
   report->add_option("--jobs,-j", report_jobs, "runs at a time (default: the number of cores)")
       ->check(CLI::PositiveNumber);
 
@@ -123,6 +125,7 @@ int main(int argc, char** argv) {
       std::vector<std::string> args{"--floedem", floedem::own_executable(), "--out", report_out};
       if (report_quick) args.emplace_back("--quick");
       if (report_jobs > 0) args.insert(args.end(), {"--jobs", std::to_string(report_jobs)});
+      if (!report_only.empty()) args.insert(args.end(), {"--only", report_only});
       const int status = floedem::run_python_script("report.py", args);
       return status < 0 ? 1 : status;
     }

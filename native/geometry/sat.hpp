@@ -24,19 +24,25 @@ struct FaceSeparation {
 };
 
 /// Largest over the edges of `a` of the smallest signed distance of `b`'s vertices to that edge.
-inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView& b) {
+/// Two exact shortcuts (the same edge and separation as the full double loop, to the bit): an
+/// edge is left at its first vertex no further than the best edge so far (its minimum cannot
+/// beat it), and the search ends at the first edge separating by more than `enough` (the caller
+/// needs to know no more: a pair beyond its contact margin).
+inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView& b,
+                                          double enough = std::numeric_limits<double>::infinity()) {
   FaceSeparation best;
   for (int i = 0; i < a.count; ++i) {
     const Vec2 n = a.normals[i];
     const Vec2 v = a.vertices[i];
     double s = std::numeric_limits<double>::infinity();
-    for (int j = 0; j < b.count; ++j) {
+    for (int j = 0; j < b.count && s > best.separation; ++j) {
       const double d = dot(n, b.vertices[j] - v);
       if (d < s) s = d;
     }
     if (s > best.separation) {
       best.separation = s;
       best.edge = i;
+      if (s > enough) break;
     }
   }
   return best;

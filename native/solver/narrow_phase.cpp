@@ -84,9 +84,9 @@ void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip,
 
 void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m) {
   m.point_count = 0;
-  const FaceSeparation sa = max_face_separation(a.world, b.world);
+  const FaceSeparation sa = max_face_separation(a.world, b.world, margin);
   if (sa.separation > margin) return;
-  const FaceSeparation sb = max_face_separation(b.world, a.world);
+  const FaceSeparation sb = max_face_separation(b.world, a.world, margin);
   if (sb.separation > margin) return;
 
   // Prefer a's face unless b's is clearly better: keeps the choice steady between steps.
