@@ -49,6 +49,17 @@ inline Scene scene_from(const std::string& toml, const std::vector<std::string>&
 
 inline std::unique_ptr<Engine> native(const Scene& s) { return make_engine("native", s); }
 
+/// x component of the contact force on `body` over the engine's last step (its impulses / dt).
+inline double contact_force_x(const Engine& e, int body, double dt) {
+  double fx = 0.0;
+  for (const ContactRecord& c : e.contacts()) {
+    const double px = c.normal_impulse * c.normal.x - c.tangent_impulse * c.normal.y;
+    if (c.body_b == body) fx += px;
+    if (c.body_a == body) fx -= px;
+  }
+  return fx / dt;
+}
+
 /// TOML array of the vertices, e.g. "[[0, 0], [1, 0], [1, 1]]", written exactly (17 digits).
 inline std::string toml_polygon(const std::vector<Vec2>& pts) {
   std::ostringstream o;

@@ -119,13 +119,8 @@ TEST_CASE("stress: a resting column carries its drag to the wall, steady to 0.1 
     double drag = 0.0;  // N, along the wind (+x), on the floes
     for (std::size_t i = 3; i < s.bodies.size(); ++i) drag += loads->force[i].x;
     e->step(loads);
-    double wall = 0.0;  // N, along +x, on the wall (body 0)
-    for (const ContactRecord& c : e->contacts()) {
-      overlap = std::max(overlap, -c.separation);
-      const double px = c.normal_impulse * c.normal.x - c.tangent_impulse * c.normal.y;
-      if (c.body_b == 0) wall += px / dt;
-      if (c.body_a == 0) wall -= px / dt;
-    }
+    const double wall = test::contact_force_x(*e, 0, dt);  // N, along +x, on the wall (body 0)
+    for (const ContactRecord& c : e->contacts()) overlap = std::max(overlap, -c.separation);
     if (k >= 5000) {  // the last 100 s
       worst = std::max(worst, std::abs(wall - drag) / drag);
       ++measured;

@@ -27,7 +27,21 @@ struct Poly {
   PartGeometry geometry() const {
     return {ConvexView{world.data(), world_n.data(), static_cast<int>(world.size())}, local.data(), local_n.data(), x};
   }
+  ConvexView view() const { return {world.data(), world_n.data(), static_cast<int>(world.size())}; }
 };
+
+/// Two random boxes (sides 0.2 to 10.2 m, aspect up to 1:50, any turn), the second's centre at
+/// `reach` times the sum of their half-diagonals from the first's, in any direction.
+std::pair<Poly, Poly> random_box_pair(std::mt19937_64& rng, double reach_low, double reach_high) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double wa = 0.2 + 10.0 * u(rng), ha = wa / (1.0 + 49.0 * u(rng));
+  const double wb = 0.2 + 10.0 * u(rng), hb = wb / (1.0 + 49.0 * u(rng));
+  const Poly a(test::box({0, 0}, wa, ha), {0, 0}, 2.0 * M_PI * u(rng));
+  const double d = 0.5 * (std::hypot(wa, ha) + std::hypot(wb, hb)) * (reach_low + (reach_high - reach_low) * u(rng));
+  const double phi = 2.0 * M_PI * u(rng);
+  const Poly b(test::box({0, 0}, wb, hb), {d * std::cos(phi), d * std::sin(phi)}, 2.0 * M_PI * u(rng));
+  return {a, b};
+}
 
 std::vector<Vec2> square(double s) { return test::box({0, 0}, s, s); }
 
@@ -121,20 +135,14 @@ TEST_CASE("corner contacts: only for polygons apart, on a plane pair that separa
   // its gap must be at least theirs (it is the true distance, they a lower bound), and the
   // planes through its two points, normal to it, must have each polygon on its own side.
   std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   int corner_contacts = 0;
   for (int trial = 0; trial < 20000; ++trial) {
-    const double wa = 0.2 + 10.0 * u(rng), ha = wa / (1.0 + 49.0 * u(rng));
-    const double wb = 0.2 + 10.0 * u(rng), hb = wb / (1.0 + 49.0 * u(rng));
-    const Poly a(test::box({0, 0}, wa, ha), {0, 0}, 2.0 * M_PI * u(rng));
-    const double d = 0.5 * (std::hypot(wa, ha) + std::hypot(wb, hb)) * (0.9 + 0.2 * u(rng));
-    const double phi = 2.0 * M_PI * u(rng);
-    const Poly b(test::box({0, 0}, wb, hb), {d * std::cos(phi), d * std::sin(phi)}, 2.0 * M_PI * u(rng));
+    const auto [a, b] = random_box_pair(rng, 0.9, 1.1);
     Manifold m;
     collide(a.geometry(), b.geometry(), 1.0, 1e-4, m);
     if (m.point_count != 1 || !(m.points[0].id & 0x40000000u)) continue;
     ++corner_contacts;
-    const ConvexView va{a.world.data(), a.world_n.data(), 4}, vb{b.world.data(), b.world_n.data(), 4};
+    const ConvexView va = a.view(), vb = b.view();
     const double sat = std::max(max_face_separation(va, vb).separation, max_face_separation(vb, va).separation);
     REQUIRE(sat > 0.0);
     const ManifoldPoint& p = m.points[0];
@@ -165,13 +173,8 @@ TEST_CASE("narrow phase: the separating axes' shortcuts give the full search's e
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int apart = 0, overlapping = 0;
   for (int trial = 0; trial < 20000; ++trial) {
-    const double wa = 0.2 + 10.0 * u(rng), ha = wa / (1.0 + 49.0 * u(rng));
-    const double wb = 0.2 + 10.0 * u(rng), hb = wb / (1.0 + 49.0 * u(rng));
-    const Poly a(test::box({0, 0}, wa, ha), {0, 0}, 2.0 * M_PI * u(rng));
-    const double d = 0.5 * (std::hypot(wa, ha) + std::hypot(wb, hb)) * (0.3 + 1.0 * u(rng));
-    const double phi = 2.0 * M_PI * u(rng);
-    const Poly b(test::box({0, 0}, wb, hb), {d * std::cos(phi), d * std::sin(phi)}, 2.0 * M_PI * u(rng));
-    const ConvexView va{a.world.data(), a.world_n.data(), 4}, vb{b.world.data(), b.world_n.data(), 4};
+    const auto [a, b] = random_box_pair(rng, 0.3, 1.3);
+    const ConvexView va = a.view(), vb = b.view();
     const FaceSeparation full = brute(va, vb), fast = max_face_separation(va, vb);
     REQUIRE(fast.edge == full.edge);
     REQUIRE(fast.separation == full.separation);

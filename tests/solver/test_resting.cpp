@@ -13,17 +13,6 @@ namespace {
 
 constexpr double kPush = 2e4;  // N
 
-double contact_force_on(const Engine& e, int body, double dt) {
-  // x component of the contact force on `body` from the step's impulses.
-  double fx = 0.0;
-  for (const ContactRecord& c : e.contacts()) {
-    const double px = c.normal_impulse * c.normal.x - c.tangent_impulse * c.normal.y;
-    if (c.body_b == body) fx += px;
-    if (c.body_a == body) fx -= px;
-  }
-  return fx / dt;
-}
-
 }  // namespace
 
 TEST_CASE("a floe pushed against a fixed wall: force equals the push, no jitter", "[resting]") {
@@ -38,7 +27,7 @@ TEST_CASE("a floe pushed against a fixed wall: force equals the push, no jitter"
   for (int k = 0; k < 2000; ++k) {
     e->step(forcing.evaluate(e->state(), k * dt));
     // The wall (body 1) is b: its contact force is +x; the floe's is -push.
-    worst_force = std::max(worst_force, std::abs(-contact_force_on(*e, 0, dt) - kPush) / kPush);
+    worst_force = std::max(worst_force, std::abs(-test::contact_force_x(*e, 0, dt) - kPush) / kPush);
     worst_speed = std::max(worst_speed, length(e->state().velocity[0]));
     worst_spin = std::max(worst_spin, std::abs(e->state().angular_velocity[0]) * 5.0);
   }
@@ -67,7 +56,7 @@ TEST_CASE("a floe accelerated into a wall bounces, then comes to rest carrying t
     for (const auto& c : e->contacts()) collisions += c.kind == ContactKind::collision;
     max_overlap = std::max(max_overlap, e->state().position[0].x + 5.0 - 10.0);
     if (k >= 5000) {
-      CHECK(std::abs(-contact_force_on(*e, 0, dt) - kPush) <= 1e-3 * kPush);
+      CHECK(std::abs(-test::contact_force_x(*e, 0, dt) - kPush) <= 1e-3 * kPush);
       CHECK(length(e->state().velocity[0]) < 1e-9);
     }
   }
