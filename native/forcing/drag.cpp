@@ -118,10 +118,37 @@ void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_
           e.moments.empty() ? std::array<double, 4>{} : e.moments.front()};
   for (const DragSlab& slab : e.slabs) q.one_flow = q.one_flow && slab.flow.x == q.flow.x && slab.flow.y == q.flow.y;
   quiet_.push_back(q);
+  for (const DragSlab& slab : e.slabs) calm_ = calm_ && slab.flow.x == 0.0 && slab.flow.y == 0.0;
+  if (kind_ == Kind::skin && settings_.reference_speed > 0.0) calm_ = false;
+  if (entry_of_body_.size() <= body) entry_of_body_.resize(body + 1, -1);
+  entry_of_body_[body] = static_cast<std::int32_t>(entries_.size());
   entries_.push_back(std::move(e));
 }
 
+template <class F>
+void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& f) const {
+  if (!calm_) {
+    thread_pool().for_blocks(entries_.size(), grain, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) f(i);
+    });
+    return;
+  }
+  // Still water and air: an entry whose body is at rest is one adds_nothing skips, so visiting
+  // the moving bodies alone gives the same sums to the bit (each entry writes its own body).
+  thread_pool().for_blocks(sums.stirred.size(), grain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto body = static_cast<std::size_t>(sums.stirred[k]);
+      if (body < entry_of_body_.size() && entry_of_body_[body] >= 0) f(static_cast<std::size_t>(entry_of_body_[body]));
+    }
+  });
+}
+
 bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const {
+  for_entries(sums, 4096, [&](std::size_t i) { add_entry_bound(i, s, sums); });
+  return true;
+}
+
+void DistributedDrag::add_entry_bound(std::size_t i, const BodyStates& s, ForceSums& sums) const {
   // Per quadrature point, with m = |u| <= |V - v| + |w| |r| and k its weight (MODEL.md 2):
   //   skin  a = k (m I + u u^T / m):    |a_00| + |a_01| <= (1 + sqrt 2) |k| m,  g^T a g <= 2 |k| m |r|^2
   //   form  a = k (-(u.n) I - u n^T):   the same two bounds (|u.n| <= m, |n_x| + |n_y| <= sqrt 2)
@@ -129,34 +156,29 @@ bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const
   // where g = k x r maps the spin to the point's velocity, so summing over the points bounds
   // the row sums of D's translational block and |D_ww| (forcing.cpp's stiffness test).
   constexpr double kRow = 1.0 + 1.4142135623730951;
-  thread_pool().for_blocks(entries_.size(), 4096, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::size_t body = quiet_[i].body;
-      const Vec2 v = s.velocity[body];
-      if (adds_nothing(i, v, s.angular_velocity[body])) continue;  // adds nothing to D either
-      const double w = std::abs(s.angular_velocity[body]);
-      std::array<double, 2>& b = sums.rate_bound[body];
-      auto add_slab = [&](const std::array<double, 4>& m, Vec2 flow) {
-        if (settings_.reference_speed > 0.0) {
-          b[0] += settings_.reference_speed * m[0];
-          b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
-          return;
-        }
-        const double du = length(flow - v);
-        const double spin = settings_.rotational ? w : 0.0;
-        b[0] += kRow * (du * m[0] + spin * m[1]);
-        b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
-      };
-      const Quiet& q = quiet_[i];
-      if (q.single) {  // one slab (a floe): all from the packed record, no trip to the entry
-        add_slab(q.moments, q.flow);
-        continue;
-      }
-      const Entry& e = entries_[i];
-      for (std::size_t k = 0; k < e.slabs.size(); ++k) add_slab(e.moments[k], e.slabs[k].flow);
+  const std::size_t body = quiet_[i].body;
+  const Vec2 v = s.velocity[body];
+  if (adds_nothing(i, v, s.angular_velocity[body])) return;  // adds nothing to D either
+  const double w = std::abs(s.angular_velocity[body]);
+  std::array<double, 2>& b = sums.rate_bound[body];
+  auto add_slab = [&](const std::array<double, 4>& m, Vec2 flow) {
+    if (settings_.reference_speed > 0.0) {
+      b[0] += settings_.reference_speed * m[0];
+      b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
+      return;
     }
-  });
-  return true;
+    const double du = length(flow - v);
+    const double spin = settings_.rotational ? w : 0.0;
+    b[0] += kRow * (du * m[0] + spin * m[1]);
+    b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
+  };
+  const Quiet& q = quiet_[i];
+  if (q.single) {  // one slab (a floe): all from the packed record, no trip to the entry
+    add_slab(q.moments, q.flow);
+    return;
+  }
+  const Entry& e = entries_[i];
+  for (std::size_t k = 0; k < e.slabs.size(); ++k) add_slab(e.moments[k], e.slabs[k].flow);
 }
 
 bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
@@ -177,29 +199,30 @@ void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
   // Entries are bodies, one each: blocks of them on the pool's threads write distinct bodies,
   // each in the same order as one thread would, so the sums do not depend on the threads.
   std::atomic<bool> any_jacobian{false};
-  thread_pool().for_blocks(entries_.size(), 512, [&](std::size_t begin, std::size_t end) {
-    bool jacobian_here = false;
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::size_t body = quiet_[i].body;
-      const Vec2 v = s.velocity[body];
-      const double w = s.angular_velocity[body];
-      if (adds_nothing(i, v, w)) continue;
-      const Entry& e = entries_[i];
-      const Rot rot = sums.rotation[e.body];
-      const bool jacobian = sums.jacobian[e.body] != 0;
-      BodySum sum = sums.load(e.body);
-      for (const DragSlab& slab : e.slabs) {
-        if (kind_ == Kind::form)
-          add_form_drag(sum, e.edges, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
-        else
-          add_skin_drag(sum, e.points, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
-      }
-      sums.store(e.body, sum);
-      jacobian_here = jacobian_here || jacobian;
-    }
-    if (jacobian_here) any_jacobian.store(true, std::memory_order_relaxed);
+  for_entries(sums, 512, [&](std::size_t i) {
+    if (add_entry(i, s, sums) && !any_jacobian.load(std::memory_order_relaxed))
+      any_jacobian.store(true, std::memory_order_relaxed);
   });
   if (any_jacobian.load(std::memory_order_relaxed)) sums.any_jacobian = true;
+}
+
+bool DistributedDrag::add_entry(std::size_t i, const BodyStates& s, ForceSums& sums) const {
+  const std::size_t body = quiet_[i].body;
+  const Vec2 v = s.velocity[body];
+  const double w = s.angular_velocity[body];
+  if (adds_nothing(i, v, w)) return false;
+  const Entry& e = entries_[i];
+  const Rot rot = sums.rotation[e.body];
+  const bool jacobian = sums.jacobian[e.body] != 0;
+  BodySum sum = sums.load(e.body);
+  for (const DragSlab& slab : e.slabs) {
+    if (kind_ == Kind::form)
+      add_form_drag(sum, e.edges, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
+    else
+      add_skin_drag(sum, e.points, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
+  }
+  sums.store(e.body, sum);
+  return jacobian;
 }
 
 }  // namespace floedem

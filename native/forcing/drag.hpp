@@ -75,6 +75,14 @@ class DistributedDrag final : public ForceTerm {
   };
   /// Entry i's body moves with every slab's flow, without spin: it adds nothing (see drag.cpp).
   bool adds_nothing(std::size_t i, Vec2 v, double w) const;
+  /// Entry i's force (and Jacobian where its body needs one); returns whether it added a Jacobian.
+  bool add_entry(std::size_t i, const BodyStates& state, ForceSums& sums) const;
+  void add_entry_bound(std::size_t i, const BodyStates& state, ForceSums& sums) const;
+  /// Calls f(i) for each entry that may add something: every entry, or in still water and air
+  /// (calm_) only those of the bodies that move (ForceSums::stirred), in blocks of `grain` on
+  /// the pool's threads.
+  template <class F>
+  void for_entries(const ForceSums& sums, std::size_t grain, F&& f) const;
   struct Quiet {
     std::size_t body;
     Vec2 flow;      // the slabs' flow, when they share one
@@ -88,6 +96,10 @@ class DistributedDrag final : public ForceTerm {
   DragSettings settings_;
   std::vector<Entry> entries_;
   std::vector<Quiet> quiet_;  // per entry, what adds_nothing reads (kept apart: read every step)
+  // Every slab's flow is zero (and the drag is not linearised skin drag, which acts at u = 0):
+  // a body at rest adds exactly nothing (adds_nothing), so only moving bodies are visited.
+  bool calm_ = true;
+  std::vector<std::int32_t> entry_of_body_;  // -1: the body has no entry
 };
 
 /// The term, or nullptr when no body needs it.

@@ -73,6 +73,10 @@ struct ForceSums {
   /// Per body, filled by ForceTerm::add_rate_bound: upper bounds on the row sums of the
   /// translational block of -D (N s/m) and on |D_ww| (N m s).
   std::vector<std::array<double, 2>> rate_bound;
+  /// The bodies that move (a nonzero velocity or spin at the state the terms see), ascending;
+  /// set by Forcing before the terms add. A term in still water and air visits only these
+  /// (a body at rest listed too costs a look, nothing more).
+  std::vector<std::int32_t> stirred;
 
   void add_force(std::size_t i, Vec2 f, double torque) {
     q[i][0] += f.x;

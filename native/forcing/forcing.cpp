@@ -34,6 +34,8 @@ constexpr ForceTermBuilder kTerms[] = {
     build_coriolis,      build_sea_surface_tilt, build_wave_radiation,  build_rope_tow,
 };
 
+bool plus_zero(double x) { return x == 0.0 && !std::signbit(x); }
+
 /// Solves the 3x3 system a x = b (Cramer's rule; a is well conditioned: M/dt dominates).
 std::array<double, 3> solve3(const std::array<double, 9>& a, const std::array<double, 3>& b) {
   const double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
@@ -81,6 +83,7 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
   sums_.rotation.resize(n);
   sums_.jacobian.assign(n, 1);
   sums_.rate_bound.resize(n);
+  sums_.stirred.reserve(n);
   rotated_angle_.assign(n, std::numeric_limits<double>::quiet_NaN());  // NaN: none computed yet
   cached_rate_.assign(n, 0.0);
   cached_tan_.assign(n, 0.0);
@@ -156,11 +159,15 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
     at = &moved_;
   }
 
-  for (std::size_t i = 0; i < hot_.size(); ++i)
+  sums_.stirred.clear();
+  for (std::size_t i = 0; i < hot_.size(); ++i) {
     if (at->angle[i] != rotated_angle_[i]) {  // the body turned (or the first step)
       sums_.rotation[i] = Rot::from_angle(at->angle[i]);
       rotated_angle_[i] = at->angle[i];
     }
+    const Vec2 v = at->velocity[i];
+    if (v.x != 0.0 || v.y != 0.0 || at->angular_velocity[i] != 0.0) sums_.stirred.push_back(static_cast<std::int32_t>(i));
+  }
   // Which bodies need D: where the terms' bound on dt |D| / M stays below the explicit limit,
   // stiff() would find the body explicit whatever D is, so D is not computed (the terms then
   // skip its nine products per quadrature point). The margin covers rounding in the sums.
@@ -170,6 +177,10 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
   for (std::size_t i = 0; i < hot_.size(); ++i) {
     const BodyHot& h = hot_[i];
     const std::array<double, 2>& b = sums_.rate_bound[i];
+    if (b[0] == 0.0 && b[1] == 0.0) {  // nothing bounded here (a body at rest in still water): rate 0
+      sums_.jacobian[i] = !bounded;
+      continue;
+    }
     const double rate = std::max(b[0] / h.mass_with_added, b[1] / h.inertia_with_added);
     sums_.jacobian[i] = !bounded || (h.moves && dt_ * rate * (1.0 + 1e-6) > kExplicitLimit);
   }
@@ -196,6 +207,15 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
       std::array<double, 3> dv;
       const double f = sums_.any_rotation ? sums_.rotation_rate[i] * h.mass / mi : 0.0;
       const bool implicit = sums_.any_jacobian && stiff(sums_.dq[i], mi, ii);
+      // A body no term pushed (Q = +0), explicit, that Coriolis cannot turn (at rest, or no
+      // rotation) gets no load: the paths below give +0 to the bit (rhs = +0 whatever the sign
+      // of a zero velocity), here without their divisions. Most floes of the towing case.
+      if (!implicit && plus_zero(q[0]) && plus_zero(q[1]) && plus_zero(q[2]) &&
+          (f == 0.0 || (state.velocity[i].x == 0.0 && state.velocity[i].y == 0.0))) {
+        loads_.force[i] = {};
+        loads_.torque[i] = 0.0;
+        continue;
+      }
       if (!implicit && f == 0.0) {
         dv = {dt_ * q[0] / mi, dt_ * q[1] / mi, dt_ * q[2] / ii};
       } else {

@@ -21,6 +21,7 @@ ForceSums sums_for(std::size_t n) {
   s.rotation.assign(n, Rot{});
   s.jacobian.assign(n, 1);
   s.rate_bound.assign(n, {});
+  for (std::size_t i = 0; i < n; ++i) s.stirred.push_back(static_cast<std::int32_t>(i));  // every body may move
   return s;
 }
 
@@ -76,4 +77,46 @@ TEST_CASE("drag: the rate bound covers the Jacobian, and Q is the same without i
           ++cases;
         }
   CHECK(cases == 1600);
+}
+
+TEST_CASE("drag: in still water only the moving bodies are visited, with the sums of the full quadrature",
+          "[forcing]") {
+  // Five floes in still water and air: at rest, moving, spinning in place, at rest, moving.
+  // Forcing lists the moving ones (ForceSums::stirred); each term then visits those alone, and
+  // must give them the quadrature's force to the bit and the ones at rest exactly nothing.
+  const std::vector<Vec2> poly{{-5.0, -3.0}, {6.0, -4.0}, {4.0, 5.0}, {-6.0, 2.0}};
+  const std::vector<Vec2> velocity{{0.0, 0.0}, {0.3, -0.1}, {0.0, 0.0}, {0.0, -0.0}, {-0.2, 0.05}};
+  const std::vector<double> spin{0.0, 0.01, -0.02, 0.0, 0.0};
+  for (const auto kind : {DistributedDrag::Kind::form, DistributedDrag::Kind::skin}) {
+    EnvironmentSpec env;
+    DistributedDrag drag("still", kind, env);
+    BodyStates s;
+    s.resize(5);
+    ForceSums sums = sums_for(5);
+    sums.stirred.clear();
+    for (std::size_t i = 0; i < 5; ++i) {
+      drag.add_body(i, poly, {{400.0, 1.0, {0.0, 0.0}}});
+      s.velocity[i] = velocity[i];
+      s.angular_velocity[i] = spin[i];
+      s.angle[i] = 0.3 * static_cast<double>(i);
+      sums.rotation[i] = Rot::from_angle(s.angle[i]);
+      if (velocity[i].x != 0.0 || velocity[i].y != 0.0 || spin[i] != 0.0) sums.stirred.push_back(static_cast<std::int32_t>(i));
+    }
+    REQUIRE(sums.stirred == std::vector<std::int32_t>{1, 2, 4});
+    drag.add(s, 0.0, sums);
+    const std::vector<EdgePoint> edges = edge_points(poly);
+    const std::vector<AreaPoint> points = area_points(poly);
+    const DragSettings settings{env.rotational_damping, env.drag_reference_speed};
+    for (std::size_t i = 0; i < 5; ++i) {
+      INFO("floe " << i);
+      BodySum expected{};
+      if (kind == DistributedDrag::Kind::form)
+        add_form_drag(expected, edges, 1.0, 400.0, {}, velocity[i], spin[i], sums.rotation[i], settings, true);
+      else
+        add_skin_drag(expected, points, 1.0, 400.0, {}, velocity[i], spin[i], sums.rotation[i], settings, true);
+      CHECK(sums.q[i] == expected.q);
+      CHECK(sums.dq[i] == expected.d);
+      if (i == 0 || i == 3) CHECK(sums.q[i] == std::array<double, 3>{});
+    }
+  }
 }
