@@ -1,6 +1,7 @@
 #pragma once
 // Velocity-level contact impulses (sequential impulses / projected Gauss-Seidel with an exact
 // local solve per contact) and the energy-free position projection.
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -26,18 +27,27 @@ inline Vec2 relative_velocity(const BodyArrays& s, int a, int b, Vec2 ra, Vec2 r
 /// target normal velocity, and fills the Delassus block.
 void prepare_contacts(std::span<Manifold> manifolds, const BodyArrays& bodies, double dt, double collision_threshold);
 
-/// Applies `impulse` (on b; its opposite on a) at point p of manifold m.
+/// Applies `impulse` (on b; its opposite on a) at point p of manifold m. A fixed or prescribed
+/// body (inv_mass = inv_inertia = 0) keeps its given velocity and is not written: the islands
+/// that share it are solved on several threads.
 inline void apply_impulse(BodyArrays& s, const Manifold& m, const ManifoldPoint& p, Vec2 impulse) {
   const int a = m.body_a, b = m.body_b;
-  s.velocity[a] -= s.inv_mass[a] * impulse;
-  s.angular_velocity[a] -= s.inv_inertia[a] * cross(p.ra, impulse);
-  s.velocity[b] += s.inv_mass[b] * impulse;
-  s.angular_velocity[b] += s.inv_inertia[b] * cross(p.rb, impulse);
+  if (s.inv_mass[a] != 0.0) {
+    s.velocity[a] -= s.inv_mass[a] * impulse;
+    s.angular_velocity[a] -= s.inv_inertia[a] * cross(p.ra, impulse);
+  }
+  if (s.inv_mass[b] != 0.0) {
+    s.velocity[b] += s.inv_mass[b] * impulse;
+    s.angular_velocity[b] += s.inv_inertia[b] * cross(p.rb, impulse);
+  }
 }
 
 /// Applies the accumulated impulses times `sign`: +1 for the warm start, -1 to take a solve's
 /// impulses off again (they are all it applied).
 void apply_accumulated_impulses(std::span<const Manifold> manifolds, BodyArrays& bodies, double sign);
+/// The same for one island's manifolds (indices into `manifolds`, in that order).
+void apply_accumulated_impulses(std::span<const Manifold> manifolds, std::span<const std::int32_t> island,
+                                BodyArrays& bodies, double sign);
 inline void warm_start(std::span<const Manifold> manifolds, BodyArrays& bodies) {
   apply_accumulated_impulses(manifolds, bodies, 1.0);
 }
@@ -62,6 +72,10 @@ struct SweepLimits {
 /// Returns the number of sweeps made.
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, const SweepLimits& limits,
                      SweepMomentum* momentum = nullptr);
+/// The same over one island's manifolds (indices into `manifolds`, swept in that order):
+/// the sweeps stop on that island's own changes and impulses.
+int solve_velocities(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& bodies,
+                     const SweepLimits& limits, SweepMomentum* momentum = nullptr);
 
 /// The largest amount by which a point approaches faster than its target (m/s, >= 0).
 double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& bodies);

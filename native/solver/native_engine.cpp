@@ -17,6 +17,7 @@
 
 #include "solver/broad_phase.hpp"
 #include "solver/pair_cache.hpp"
+#include "solver/contact_islands.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/island_solve.hpp"
 #include "solver/narrow_phase.hpp"
@@ -52,10 +53,14 @@ class NativeEngine final : public Engine {
   Aabb reach_box(std::int32_t k, double reach) const;
   void collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m) const;
   void solve_contacts();
+  struct IslandWork;
+  int solve_island(std::size_t island, bool checked, IslandWork& work);
   void solve_islands_directly(double energy_before);
   bool contacts_gain_energy(double energy_before) const;
   double contact_kinetic_energy() const;
+  double kinetic_energy_of(std::span<const std::int32_t> bodies) const;
   double kinematic_work() const;
+  double kinematic_work(const Manifold& m) const;
 
   NativeSettings settings_;
   ContactSettings contact_;
@@ -81,7 +86,8 @@ class NativeEngine final : public Engine {
   std::vector<Manifold> manifolds_, previous_manifolds_;
   std::vector<ContactRecord> records_;
   // Measured figures, reported by info(): solver work and warm-start fallbacks over the run.
-  std::int64_t total_sweeps_ = 0;
+  std::int64_t total_sweeps_ = 0;          // per step, the most sweeps any island took
+  std::int64_t total_islands_ = 0;
   std::int64_t steps_ = 0;
   std::int64_t cold_restarts_ = 0;
   std::int64_t redetections_ = 0;          // steps whose contacts were found again (outran reach)
@@ -89,14 +95,24 @@ class NativeEngine final : public Engine {
   static constexpr int kFrictionRounds = 8;   // cut friction, solve the normals again (drift_in_field: 88 % of solves cut nothing, 99 % within 2 rounds)
   std::int64_t direct_solves_ = 0;    // steps whose islands were solved directly
   std::int64_t direct_reverted_ = 0;  // ... and then given back (they would have made energy)
+  ContactIslands islands_;
+  /// What one block of islands works in, on whichever thread takes it (no allocation per step
+  /// once sized), and what it reports back.
+  struct IslandWork {
+    SweepMomentum momentum;         // the accelerated sweeps' work arrays
+    std::vector<Vec2> velocity;     // an island's bodies' velocities before its solve (cold restart)
+    std::vector<double> angular_velocity;
+    int longest = 0;        // most sweeps an island of the block took
+    int cold_restarts = 0;  // islands of the block solved again from zero
+  };
+  std::vector<IslandWork> island_work_;  // per block of islands
+  static constexpr std::size_t kIslandGrain = 8;  // islands per block
   std::vector<Vec2> saved_velocity_;
   std::vector<double> saved_angular_velocity_;
   std::vector<double> saved_impulses_;
   std::vector<std::int32_t> island_index_;  // the manifolds of the islands solved directly
   std::vector<Manifold> island_manifolds_;  // ... copied out for their sweeps
   IslandSolver island_solver_;
-  SweepMomentum momentum_;  // the accelerated sweeps' work arrays
-  SweepMomentum* momentum() { return settings_.accelerate ? &momentum_ : nullptr; }
   /// The sweeps' limits: extra sweeps while a point would close by more than the allowed overlap within the step.
   SweepLimits sweep_limits() const {
     return {settings_.velocity_iterations, settings_.tolerance, settings_.extra_iterations,
@@ -164,6 +180,7 @@ EngineInfo NativeEngine::info() const {
       {"direct_solves", std::to_string(direct_solves_)},
       {"direct_solves_reverted", std::to_string(direct_reverted_)},
       {"mean_sweeps_per_step", setting_text(steps_ > 0 ? static_cast<double>(total_sweeps_) / static_cast<double>(steps_) : 0.0)},
+      {"mean_islands_per_step", setting_text(steps_ > 0 ? static_cast<double>(total_islands_) / static_cast<double>(steps_) : 0.0)},
       {"cold_restarts", std::to_string(cold_restarts_)},
       {"redetections", std::to_string(redetections_)},
       {"broad_phase_rebuilds", std::to_string(pair_cache_.rebuilds())},
@@ -202,6 +219,7 @@ bool NativeEngine::save_state(StateWriter& out) const {
   out.value(redetections_);
   out.value(direct_solves_);
   out.value(direct_reverted_);
+  out.value(total_islands_);
   return true;
 }
 
@@ -239,6 +257,7 @@ void NativeEngine::restore_state(StateReader& in) {
   in.value(redetections_);
   in.value(direct_solves_);
   in.value(direct_reverted_);
+  in.value(total_islands_);
   records_.clear();  // the contacts of the step before the checkpoint are not needed again
 }
 
@@ -459,36 +478,81 @@ void NativeEngine::build_manifolds() {
 }
 
 void NativeEngine::solve_contacts() {
+  // Islands (contact_islands.hpp) share no moving body, so each is solved apart: its sweeps
+  // stop when its own impulses have converged (or its limits are spent), and its energy is
+  // checked on its own. One island's hard case (the pile ahead of a towed iceberg, a pressed
+  // chain) no longer keeps every other contact of the scene sweeping, and an island that made
+  // energy is solved again without touching the rest. A scene that is one island is solved
+  // exactly as one solve over all its manifolds.
+  const bool checked = settings_.warm_start || settings_.accelerate;
+  const double before = heavy_light_ ? contact_kinetic_energy() : 0.0;
+  islands_.build(manifolds_, bodies_);
+  // Blocks of islands on the pool's threads: an island touches only its own manifolds and
+  // moving bodies (the velocity of a fixed or prescribed body is never written, see
+  // apply_impulse), and each is solved the same way on any thread, so the result does not
+  // depend on the thread count.
+  const std::size_t n = islands_.size();
+  const std::size_t blocks = std::max<std::size_t>(1, (n + kIslandGrain - 1) / kIslandGrain);
+  if (island_work_.size() < blocks) island_work_.resize(blocks);
+  for (IslandWork& w : island_work_) w.longest = w.cold_restarts = 0;
+  thread_pool().for_blocks(n, kIslandGrain, [&](std::size_t begin, std::size_t end) {
+    IslandWork& w = island_work_[begin / kIslandGrain];
+    for (std::size_t i = begin; i < end; ++i) w.longest = std::max(w.longest, solve_island(i, checked, w));
+  });
+  int longest = 0;
+  for (const IslandWork& w : island_work_) {
+    longest = std::max(longest, w.longest);
+    cold_restarts_ += w.cold_restarts;
+  }
+  total_sweeps_ += longest;
+  total_islands_ += static_cast<std::int64_t>(n);
+  // Out of sweeps: an island Gauss-Seidel cannot hold (heavy-light chains) gets its normal
+  // impulses solved directly. Below a mass ratio of a few hundred the sweeps hold a chain
+  // (measured in the stress suite: 0.5 mm at 1e2 with 50 sweeps, 5 mm at 1e3), and a scene
+  // without such a ratio between any two moving bodies never looks (heavy_light_).
+  if (heavy_light_ && longest >= settings_.velocity_iterations) solve_islands_directly(before);
+}
+
+int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& work) {
   // Gauss-Seidel from zero impulses cannot raise the kinetic energy: with a non-positive target
   // each local update moves the velocity to the constraint set along M^-1 J^T, which never
   // raises 1/2 v'Mv (a projection in the metric of M). Warm starting (last step's impulses
   // applied before the sweeps) and the conjugate-gradient steps leave that argument: when the
   // sweep limit stops the solve short of convergence (long pressed chains), what remains of the
-  // warm start, or of a step, can raise it. So a step whose contact impulses would add kinetic
-  // energy is solved again from zero with plain sweeps (contacts_gain_energy: the test).
-  const bool checked = settings_.warm_start || settings_.accelerate;
-  const double before = checked || heavy_light_ ? contact_kinetic_energy() : 0.0;
+  // warm start, or of a step, can raise it. So an island whose contact impulses would add
+  // kinetic energy is solved again from zero with plain sweeps (the test: see
+  // contacts_gain_energy).
+  const std::span<const std::int32_t> manifolds = islands_.manifolds(island);
+  const std::span<const std::int32_t> bodies = islands_.bodies(island);
+  double before = 0.0;
   if (checked) {
-    saved_velocity_ = bodies_.velocity;
-    saved_angular_velocity_ = bodies_.angular_velocity;
+    before = kinetic_energy_of(bodies);
+    work.velocity.clear();
+    work.angular_velocity.clear();
+    for (const std::int32_t b : bodies) {
+      work.velocity.push_back(bodies_.velocity[b]);
+      work.angular_velocity.push_back(bodies_.angular_velocity[b]);
+    }
   }
-  if (settings_.warm_start) warm_start(manifolds_, bodies_);
-  int sweeps = solve_velocities(manifolds_, bodies_, sweep_limits(), momentum());
-  if (checked && contacts_gain_energy(before)) {
-    total_sweeps_ += sweeps;
-    bodies_.velocity = saved_velocity_;
-    bodies_.angular_velocity = saved_angular_velocity_;
-    for (Manifold& m : manifolds_)
-      for (int k = 0; k < m.point_count; ++k) m.points[k].normal_impulse = m.points[k].tangent_impulse = 0.0;
-    sweeps = solve_velocities(manifolds_, bodies_, sweep_limits());  // plain sweeps: no energy made
-    ++cold_restarts_;
+  if (settings_.warm_start) apply_accumulated_impulses(manifolds_, manifolds, bodies_, 1.0);
+  int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(),
+                                settings_.accelerate ? &work.momentum : nullptr);
+  if (!checked) return sweeps;
+  double pushed = 0.0;  // the work of towed bodies on this island's floes (contacts_gain_energy)
+  if (has_prescribed_)
+    for (const std::int32_t k : manifolds) pushed += kinematic_work(manifolds_[k]);
+  if (kinetic_energy_of(bodies) - 2.0 * pushed <= before) return sweeps;
+  for (std::size_t x = 0; x < bodies.size(); ++x) {
+    bodies_.velocity[bodies[x]] = work.velocity[x];
+    bodies_.angular_velocity[bodies[x]] = work.angular_velocity[x];
   }
-  total_sweeps_ += sweeps;
-  // Out of sweeps: an island Gauss-Seidel cannot hold (heavy-light chains) gets its normal
-  // impulses solved directly. Below a mass ratio of a few hundred the sweeps hold a chain
-  // (measured in the stress suite: 0.5 mm at 1e2 with 50 sweeps, 5 mm at 1e3), and a scene
-  // without such a ratio between any two moving bodies never looks (heavy_light_).
-  if (heavy_light_ && sweeps >= settings_.velocity_iterations) solve_islands_directly(before);
+  for (const std::int32_t k : manifolds) {
+    Manifold& m = manifolds_[k];
+    for (int j = 0; j < m.point_count; ++j) m.points[j].normal_impulse = m.points[j].tangent_impulse = 0.0;
+  }
+  sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits());  // plain sweeps: no energy made
+  ++work.cold_restarts;
+  return sweeps;
 }
 
 bool NativeEngine::contacts_gain_energy(double before) const {
@@ -562,23 +626,36 @@ void NativeEngine::solve_islands_directly(double before) {
 }
 
 double NativeEngine::kinematic_work() const {
+  double w = 0.0;
+  for (const Manifold& m : manifolds_) w += kinematic_work(m);
+  return w;
+}
+
+double NativeEngine::kinematic_work(const Manifold& m) const {
   // Work of the contact impulses of bodies on a prescribed path on the bodies they touch
   // (fixed bodies do none: their points do not move).
+  const bool a_kinematic = bodies_.inv_mass[m.body_a] == 0.0, b_kinematic = bodies_.inv_mass[m.body_b] == 0.0;
+  if (!a_kinematic && !b_kinematic) return 0.0;
   double w = 0.0;
-  for (const Manifold& m : manifolds_) {
-    const bool a_kinematic = bodies_.inv_mass[m.body_a] == 0.0, b_kinematic = bodies_.inv_mass[m.body_b] == 0.0;
-    if (!a_kinematic && !b_kinematic) continue;
-    const Vec2 t = perp(m.normal);
-    for (int k = 0; k < m.point_count; ++k) {
-      const ManifoldPoint& p = m.points[k];
-      const Vec2 impulse_on_b = p.normal_impulse * m.normal + p.tangent_impulse * t;
-      if (a_kinematic)
-        w += dot(impulse_on_b, bodies_.velocity[m.body_a] + cross(bodies_.angular_velocity[m.body_a], p.ra));
-      if (b_kinematic)
-        w -= dot(impulse_on_b, bodies_.velocity[m.body_b] + cross(bodies_.angular_velocity[m.body_b], p.rb));
-    }
+  const Vec2 t = perp(m.normal);
+  for (int k = 0; k < m.point_count; ++k) {
+    const ManifoldPoint& p = m.points[k];
+    const Vec2 impulse_on_b = p.normal_impulse * m.normal + p.tangent_impulse * t;
+    if (a_kinematic)
+      w += dot(impulse_on_b, bodies_.velocity[m.body_a] + cross(bodies_.angular_velocity[m.body_a], p.ra));
+    if (b_kinematic)
+      w -= dot(impulse_on_b, bodies_.velocity[m.body_b] + cross(bodies_.angular_velocity[m.body_b], p.rb));
   }
   return w;
+}
+
+double NativeEngine::kinetic_energy_of(std::span<const std::int32_t> bodies) const {
+  // Twice the kinetic energy of these moving bodies, as contact_kinetic_energy.
+  double e = 0.0;
+  for (const std::int32_t i : bodies)
+    e += length_squared(bodies_.velocity[i]) / bodies_.inv_mass[i] +
+         bodies_.angular_velocity[i] * bodies_.angular_velocity[i] / bodies_.inv_inertia[i];
+  return e;
 }
 
 double NativeEngine::contact_kinetic_energy() const {

@@ -1,0 +1,73 @@
+#include "solver/contact_islands.hpp"
+
+#include <algorithm>
+
+namespace floedem {
+
+std::int32_t ContactIslands::find(std::int32_t body) {
+  while (parent_[body] != body) {
+    parent_[body] = parent_[parent_[body]];  // path halving
+    body = parent_[body];
+  }
+  return body;
+}
+
+void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays& bodies) {
+  const std::size_t nb = bodies.inv_mass.size();
+  if (parent_.size() != nb) {
+    parent_.assign(nb, -1);
+    root_island_.assign(nb, -1);
+    touched_.clear();
+  }
+  for (const std::int32_t b : touched_) parent_[b] = root_island_[b] = -1;  // last build's, only
+  touched_.clear();
+  auto moving = [&](std::int32_t b) { return bodies.inv_mass[b] != 0.0; };  // as apply_impulse
+  auto touch = [&](std::int32_t b) {
+    if (parent_[b] >= 0) return;
+    parent_[b] = b;
+    touched_.push_back(b);
+  };
+  for (const Manifold& m : manifolds) {
+    const bool ma = moving(m.body_a), mb = moving(m.body_b);
+    if (ma) touch(m.body_a);
+    if (mb) touch(m.body_b);
+    if (!ma || !mb) continue;
+    const std::int32_t ra = find(m.body_a), rb = find(m.body_b);
+    if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
+  }
+
+  // Islands numbered by their first manifold. A manifold between two bodies that cannot move
+  // (never paired by the broad phase) would be an island of its own.
+  const std::size_t nm = manifolds.size();
+  manifold_island_.resize(nm);
+  std::int32_t islands = 0;
+  for (std::size_t k = 0; k < nm; ++k) {
+    const Manifold& m = manifolds[k];
+    const std::int32_t b = moving(m.body_a) ? m.body_a : m.body_b;
+    if (!moving(b)) {
+      manifold_island_[k] = islands++;
+      continue;
+    }
+    const std::int32_t r = find(b);
+    if (root_island_[r] < 0) root_island_[r] = islands++;
+    manifold_island_[k] = root_island_[r];
+  }
+
+  // Grouped by island (counting sort, stable: each island's manifolds and bodies ascending).
+  manifold_start_.assign(static_cast<std::size_t>(islands) + 1, 0);
+  for (const std::int32_t i : manifold_island_) ++manifold_start_[i + 1];
+  for (std::int32_t i = 0; i < islands; ++i) manifold_start_[i + 1] += manifold_start_[i];
+  fill_.assign(manifold_start_.begin(), manifold_start_.end() - 1);
+  manifold_.resize(nm);
+  for (std::size_t k = 0; k < nm; ++k) manifold_[fill_[manifold_island_[k]]++] = static_cast<std::int32_t>(k);
+
+  std::sort(touched_.begin(), touched_.end());
+  body_start_.assign(static_cast<std::size_t>(islands) + 1, 0);
+  for (const std::int32_t b : touched_) ++body_start_[root_island_[find(b)] + 1];
+  for (std::int32_t i = 0; i < islands; ++i) body_start_[i + 1] += body_start_[i];
+  fill_.assign(body_start_.begin(), body_start_.end() - 1);
+  body_.resize(touched_.size());
+  for (const std::int32_t b : touched_) body_[fill_[root_island_[find(b)]]++] = b;
+}
+
+}  // namespace floedem
