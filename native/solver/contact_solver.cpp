@@ -28,8 +28,8 @@
 namespace floedem {
 
 namespace {
-// Inlined into the sweep (one call per point per sweep: the call and its spills were 5 % of the
-// towing case's instructions); the same arithmetic as a call, so the same impulses to the bit.
+// Inlined into the sweep (called once per point per sweep; inlined, the towing case's sweeps
+// take about 3 % fewer instructions); the same arithmetic as a call, so the same impulses to the bit.
 [[gnu::always_inline]] inline LocalImpulse local_impulse(double ufn, double uft, double target, double mu, double wnn,
                                                         double wnt, double wtt) {
   const double need = target - ufn;  // normal velocity change wanted
