@@ -11,6 +11,7 @@
 #include "solver/native_engine.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -83,6 +84,20 @@ class NativeEngine final : public Engine {
   PairCache pair_cache_;
   std::vector<PartPair> pairs_;
   std::vector<Manifold> narrow_;          // per pair this step: the narrow phase's result
+  // Narrow-phase reuse: collide() is a pure function of the two parts' placement and reaches,
+  // so a pair whose bodies sit exactly where they sat at the last step (position and rotation
+  // the same to the bit) with the same reaches gets the manifold computed last time, not a new
+  // one. In the towing case most pairs are of floes at rest.
+  std::vector<Vec2> placed_position_;      // per body: where its parts were last placed
+  std::vector<Rot> placed_rotation_;
+  std::vector<std::uint8_t> unmoved_;      // per body: placed where it was at the last step
+  bool any_unmoved_ = false;               // ... any body (else no reuse is looked for: a drifting field)
+  std::vector<Manifold> previous_narrow_;  // the last narrow phase's results ...
+  std::vector<PartPair> previous_pairs_;   // ... for these pairs ...
+  std::vector<double> previous_reach_;     // ... with these part reaches
+  std::vector<std::int32_t> reuse_;        // per pair: its slot in previous_narrow_, or -1
+  std::int64_t narrow_pairs_ = 0, narrow_reused_ = 0;  // pairs tested over the run, and those reused (info)
+  void forget_narrow();                    // no reuse at the next narrow phase
   std::vector<Manifold> manifolds_, previous_manifolds_;
   std::vector<ContactRecord> records_;
   // Measured figures, reported by info(): solver work and warm-start fallbacks over the run.
@@ -158,6 +173,7 @@ NativeEngine::NativeEngine(const Scene& scene)
   part_reach_.resize(parts_.size());
   part_margin_.resize(parts_.size());
   outran_.assign(n, 0);
+  forget_narrow();
 }
 
 EngineInfo NativeEngine::info() const {
@@ -182,6 +198,7 @@ EngineInfo NativeEngine::info() const {
       {"mean_sweeps_per_step", setting_text(steps_ > 0 ? static_cast<double>(total_sweeps_) / static_cast<double>(steps_) : 0.0)},
       {"mean_islands_per_step", setting_text(steps_ > 0 ? static_cast<double>(total_islands_) / static_cast<double>(steps_) : 0.0)},
       {"cold_restarts", std::to_string(cold_restarts_)},
+      {"narrow_phase_reused", setting_text(narrow_pairs_ > 0 ? static_cast<double>(narrow_reused_) / static_cast<double>(narrow_pairs_) : 0.0)},
       {"redetections", std::to_string(redetections_)},
       {"broad_phase_rebuilds", std::to_string(pair_cache_.rebuilds())},
       {"broad_phase_refreshed_parts", std::to_string(pair_cache_.refreshed_parts())},
@@ -220,6 +237,8 @@ bool NativeEngine::save_state(StateWriter& out) const {
   out.value(direct_solves_);
   out.value(direct_reverted_);
   out.value(total_islands_);
+  out.value(narrow_pairs_);
+  out.value(narrow_reused_);
   return true;
 }
 
@@ -258,7 +277,10 @@ void NativeEngine::restore_state(StateReader& in) {
   in.value(direct_solves_);
   in.value(direct_reverted_);
   in.value(total_islands_);
+  in.value(narrow_pairs_);
+  in.value(narrow_reused_);
   records_.clear();  // the contacts of the step before the checkpoint are not needed again
+  forget_narrow();   // a restored run computes its first narrow phase afresh, as the saved one did
 }
 
 void NativeEngine::step(const Loads* loads) {
@@ -382,8 +404,35 @@ void NativeEngine::find_pairs(const Loads* loads) {
     linear_reach_[i] = dt_ * speed;
     angular_reach_[i] = dt_ * spin;
   }
+  bool unmoved = false;
+  for (std::size_t i = 0; i < nb; ++i) {
+    const Vec2 x = bodies_.position[i];
+    const Rot q = bodies_.rotation[i];
+    const Vec2 px = placed_position_[i];
+    const Rot pq = placed_rotation_[i];
+    const bool same = std::bit_cast<std::uint64_t>(x.x) == std::bit_cast<std::uint64_t>(px.x) &&
+                      std::bit_cast<std::uint64_t>(x.y) == std::bit_cast<std::uint64_t>(px.y) &&
+                      std::bit_cast<std::uint64_t>(q.c) == std::bit_cast<std::uint64_t>(pq.c) &&
+                      std::bit_cast<std::uint64_t>(q.s) == std::bit_cast<std::uint64_t>(pq.s);
+    unmoved_[i] = same ? 1 : 0;
+    unmoved = unmoved || same;
+    if (same) continue;
+    placed_position_[i] = x;
+    placed_rotation_[i] = q;
+  }
+  any_unmoved_ = unmoved;
   parts_.place(bodies_.position, bodies_.rotation);
   pair_up();
+}
+
+void NativeEngine::forget_narrow() {
+  placed_position_.assign(bodies_.position.size(), Vec2{std::numeric_limits<double>::quiet_NaN(), 0.0});
+  placed_rotation_.assign(bodies_.position.size(), Rot{});
+  unmoved_.assign(bodies_.position.size(), 0);
+  any_unmoved_ = false;
+  previous_pairs_.clear();
+  previous_narrow_.clear();
+  previous_reach_.clear();
 }
 
 void NativeEngine::pair_up() {
@@ -427,8 +476,32 @@ void NativeEngine::build_manifolds() {
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
   narrow_.resize(pairs_.size());
+  // Which pairs the last narrow phase computed with the same inputs (both lists sorted).
+  const bool may_reuse = any_unmoved_ && !previous_pairs_.empty();
+  if (may_reuse) {
+    reuse_.resize(pairs_.size());
+    auto same_reach = [&](std::int32_t part) {
+      return std::bit_cast<std::uint64_t>(part_reach_[part]) == std::bit_cast<std::uint64_t>(previous_reach_[part]);
+    };
+    std::size_t last = 0;
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+      const PartPair pair = pairs_[k];
+      reuse_[k] = -1;
+      if (!unmoved_[parts_.body()[pair.a]] || !unmoved_[parts_.body()[pair.b]]) continue;
+      while (last < previous_pairs_.size() && previous_pairs_[last] < pair) ++last;
+      if (last < previous_pairs_.size() && previous_pairs_[last] == pair && same_reach(pair.a) && same_reach(pair.b)) {
+        reuse_[k] = static_cast<std::int32_t>(last);
+        ++narrow_reused_;
+      }
+    }
+  }
+  narrow_pairs_ += static_cast<std::int64_t>(pairs_.size());
   thread_pool().for_blocks(pairs_.size(), 512, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
+      if (may_reuse && reuse_[k] >= 0) {
+        narrow_[k] = previous_narrow_[static_cast<std::size_t>(reuse_[k])];
+        continue;
+      }
       const PartPair pair = pairs_[k];
       // Every field the solver reads is set here or by collide() (which sets the face and
       // each point it adds in full); a slot is not cleared first (a Manifold is ~400 bytes,
@@ -446,8 +519,9 @@ void NativeEngine::build_manifolds() {
   std::size_t old = 0;  // both lists are sorted by (part_a, part_b): a merge carries impulses over
   for (std::size_t slot = 0; slot < pairs_.size(); ++slot) {
     const PartPair pair = pairs_[slot];
-    Manifold& m = narrow_[slot];
-    if (m.point_count == 0) continue;
+    if (narrow_[slot].point_count == 0) continue;
+    manifolds_.push_back(narrow_[slot]);  // narrow_ keeps the narrow phase's own result (reuse)
+    Manifold& m = manifolds_.back();
     while (old < previous_manifolds_.size() &&
            PartPair{previous_manifolds_[old].part_a, previous_manifolds_[old].part_b} < pair)
       ++old;
@@ -468,8 +542,10 @@ void NativeEngine::build_manifolds() {
         }
       }
     }
-    manifolds_.push_back(m);
   }
+  std::swap(narrow_, previous_narrow_);
+  previous_pairs_.assign(pairs_.begin(), pairs_.end());
+  previous_reach_.assign(part_reach_.begin(), part_reach_.end());
   prepare_contacts(manifolds_, bodies_, dt_, contact_.collision_threshold);
   // A point that is now a collision starts from zero: Newton's law fixes its impulse.
   for (Manifold& m : manifolds_)

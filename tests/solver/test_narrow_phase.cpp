@@ -2,6 +2,8 @@
 
 #include <random>
 
+#include "engine/state_io.hpp"
+#include "run/stepper.hpp"
 #include "solver/narrow_phase.hpp"
 #include "support.hpp"
 
@@ -186,4 +188,44 @@ TEST_CASE("narrow phase: the separating axes' shortcuts give the full search's e
   }
   CHECK(apart > 1000);
   CHECK(overlapping > 1000);
+}
+
+TEST_CASE("narrow phase: pairs of floes at rest reuse their manifolds to the bit of a fresh computation", "[narrow]") {
+  // Still water: a block of floes at rest, side by side (touching: paired every step), and one
+  // floe driven into its corner. Most pairs' bodies sit still, so their
+  // manifolds are carried over from the last step instead of computed. Run B is restored from
+  // run A's state at step 150 (a restored engine computes its first narrow phase afresh); both
+  // must end the same to the bit, and the reuse must have been in play.
+  std::string text = test::header_toml(1.0, 0.05, 0.1, 0.3);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j)
+      text += test::body_toml({"f" + std::to_string(i) + "_" + std::to_string(j),
+                               test::box({10.0 * i, 10.0 * j}, 10.0, 10.0, 0.0), {}, 0.0});
+  text += test::body_toml({"striker", test::box({-12.0, -12.0}, 8.0, 8.0, 0.4), {0.8, 0.7}, 0.02});
+  const Scene s = test::scene_from(text);
+  Stepper a(s, "native");
+  for (int k = 0; k < 150; ++k) a.step();
+  StateWriter saved;
+  REQUIRE(a.save(saved));
+  Stepper b(s, "native");
+  StateReader in(saved.bytes().data(), saved.bytes().size());
+  b.restore(in);
+  for (int k = 0; k < 250; ++k) {
+    a.step();
+    b.step();
+  }
+  REQUIRE(a.contacts().size() > 0);
+  const double reused = std::stod(a.engine().info().settings.at("narrow_phase_reused"));
+  INFO("fraction of pairs reused: " << reused);
+  CHECK(reused > 0.2);  // measured 0.32: the strike sets much of the block moving
+  const BodyStates& x = a.state();
+  const BodyStates& y = b.state();
+  for (std::size_t i = 0; i < x.position.size(); ++i) {
+    INFO("body " << i);
+    CHECK(x.position[i].x == y.position[i].x);
+    CHECK(x.position[i].y == y.position[i].y);
+    CHECK(x.angle[i] == y.angle[i]);
+    CHECK(x.velocity[i].x == y.velocity[i].x);
+    CHECK(x.angular_velocity[i] == y.angular_velocity[i]);
+  }
 }
