@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   report->add_option("--out,-o", report_out, "report directory (its fig/ and runs/ are replaced)")->capture_default_str();
   report->add_flag("--quick", report_quick,
                    "the same sections on smaller, shorter cases (the CI cross-check; a few minutes on 2 cores)");
-  report->add_option("--only", report_only, "a partial report of these sections alone, comma-separated (impacts, towing, field, channel, stress, speed, cost_error, engines)");
+  report->add_option("--only", report_only, "a partial report of these sections alone, comma-separated (report.py names them; an unknown one is refused with the list)");
   report->add_option("--jobs,-j", report_jobs, "runs at a time (default: the number of cores)")
       ->check(CLI::PositiveNumber);
 

@@ -64,6 +64,7 @@ class DistributedDrag final : public ForceTerm {
   std::string_view name() const override { return name_; }
   void add(const BodyStates& state, double time, ForceSums& sums) const override;
   bool add_rate_bound(const BodyStates& state, ForceSums& sums) const override;
+  bool reads_stirred() const override { return calm_; }
 
  private:
   struct Entry {

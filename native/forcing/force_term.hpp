@@ -74,8 +74,8 @@ struct ForceSums {
   /// translational block of -D (N s/m) and on |D_ww| (N m s).
   std::vector<std::array<double, 2>> rate_bound;
   /// The bodies that move (a nonzero velocity or spin at the state the terms see), ascending;
-  /// set by Forcing before the terms add. A term in still water and air visits only these
-  /// (a body at rest listed too costs a look, nothing more).
+  /// set by Forcing before the terms add, when a term reads it (ForceTerm::reads_stirred). A
+  /// term in still water and air visits only these (a body at rest listed too costs a look).
   std::vector<std::int32_t> stirred;
 
   void add_force(std::size_t i, Vec2 f, double torque) {
@@ -114,6 +114,8 @@ class ForceTerm {
   /// True for a term that only adds a constant rotation rate (Coriolis): a scene whose terms
   /// are all such takes a precomputed per-body path (Forcing::evaluate).
   virtual bool constant_rotation_only() const { return false; }
+  /// True for a term that reads ForceSums::stirred (Forcing lists the moving bodies only then).
+  virtual bool reads_stirred() const { return false; }
 };
 
 /// Builds the term for a scene, or returns nullptr when the scene does not use it.
@@ -155,6 +157,7 @@ class Forcing {
   /// -f' dt / 2 on the first step (the trapezoidal start) and -f' dt after, handed to the
   /// engine as Loads::velocity_turn.
   bool rotation_only_ = false;
+  bool list_stirred_ = false;  // some term reads ForceSums::stirred
   std::vector<Rot> turn_first_, turn_later_;
   const std::vector<Rot>* turn_handed_ = nullptr;
 };

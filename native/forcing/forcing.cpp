@@ -83,7 +83,8 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
   sums_.rotation.resize(n);
   sums_.jacobian.assign(n, 1);
   sums_.rate_bound.resize(n);
-  sums_.stirred.reserve(n);
+  list_stirred_ = std::any_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->reads_stirred(); });
+  if (list_stirred_) sums_.stirred.reserve(n);
   rotated_angle_.assign(n, std::numeric_limits<double>::quiet_NaN());  // NaN: none computed yet
   cached_rate_.assign(n, 0.0);
   cached_tan_.assign(n, 0.0);
@@ -166,7 +167,8 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
       rotated_angle_[i] = at->angle[i];
     }
     const Vec2 v = at->velocity[i];
-    if (v.x != 0.0 || v.y != 0.0 || at->angular_velocity[i] != 0.0) sums_.stirred.push_back(static_cast<std::int32_t>(i));
+    if (list_stirred_ && (v.x != 0.0 || v.y != 0.0 || at->angular_velocity[i] != 0.0))
+      sums_.stirred.push_back(static_cast<std::int32_t>(i));
   }
   // Which bodies need D: where the terms' bound on dt |D| / M stays below the explicit limit,
   // stiff() would find the body explicit whatever D is, so D is not computed (the terms then

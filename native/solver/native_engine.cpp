@@ -60,6 +60,7 @@ class NativeEngine final : public Engine {
   bool contacts_gain_energy(double energy_before) const;
   double contact_kinetic_energy() const;
   double kinetic_energy_of(std::span<const std::int32_t> bodies) const;
+  double twice_kinetic_energy(std::size_t body) const;  // m |v|^2 + I w^2
   double kinematic_work() const;
   double kinematic_work(const Manifold& m) const;
 
@@ -725,12 +726,15 @@ double NativeEngine::kinematic_work(const Manifold& m) const {
   return w;
 }
 
+double NativeEngine::twice_kinetic_energy(std::size_t i) const {
+  return length_squared(bodies_.velocity[i]) / bodies_.inv_mass[i] +
+         bodies_.angular_velocity[i] * bodies_.angular_velocity[i] / bodies_.inv_inertia[i];
+}
+
 double NativeEngine::kinetic_energy_of(std::span<const std::int32_t> bodies) const {
   // Twice the kinetic energy of these moving bodies, as contact_kinetic_energy.
   double e = 0.0;
-  for (const std::int32_t i : bodies)
-    e += length_squared(bodies_.velocity[i]) / bodies_.inv_mass[i] +
-         bodies_.angular_velocity[i] * bodies_.angular_velocity[i] / bodies_.inv_inertia[i];
+  for (const std::int32_t i : bodies) e += twice_kinetic_energy(static_cast<std::size_t>(i));
   return e;
 }
 
@@ -738,11 +742,8 @@ double NativeEngine::contact_kinetic_energy() const {
   // Twice the kinetic energy of the moving bodies: enough to compare before and after.
   double e = 0.0;
   const std::size_t nb = bodies_.position.size();
-  for (std::size_t i = 0; i < nb; ++i) {
-    if (bodies_.inv_mass[i] == 0.0) continue;
-    e += length_squared(bodies_.velocity[i]) / bodies_.inv_mass[i] +
-         bodies_.angular_velocity[i] * bodies_.angular_velocity[i] / bodies_.inv_inertia[i];
-  }
+  for (std::size_t i = 0; i < nb; ++i)
+    if (bodies_.inv_mass[i] != 0.0) e += twice_kinetic_energy(i);
   return e;
 }
 
