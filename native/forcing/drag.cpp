@@ -35,6 +35,55 @@ std::vector<AreaPoint> area_points(const std::vector<Vec2>& poly) {
   return out;
 }
 
+namespace {
+// One quadrature point's drag law, shared by the point-by-point rule and the packed term (the
+// same arithmetic, so the same sums to the bit). r: the point's offset (world), u: the flow
+// relative to it, k: its weight.
+
+// Form drag on an edge point of outward normal n, facing the flow (u.n < 0).
+[[gnu::always_inline]] inline void add_form_point(BodySum& sum, Vec2 r, Vec2 n, Vec2 u, double un, double k,
+                                                  const DragSettings& s, bool jacobian) {
+  std::array<double, 4> a{};  // dF/du, computed only when the body needs its Jacobian
+  Vec2 f;
+  if (s.reference_speed > 0.0) {
+    // Linearised: |u| -> U_ref, so dF = k U_ref cos(theta) u with cos(theta) = -u.n / |u|.
+    const double cos_theta = -un / length(u);
+    f = (k * s.reference_speed * cos_theta) * u;
+    if (jacobian) a = {k * s.reference_speed * cos_theta, 0.0, 0.0, k * s.reference_speed * cos_theta};
+  } else {
+    // dF = k (-u.n) u,  dF/du = k ((-u.n) I - u n^T).
+    f = (-k * un) * u;
+    if (jacobian) a = {k * (-un - u.x * n.x), -k * u.x * n.y, -k * u.y * n.x, k * (-un - u.y * n.y)};
+  }
+  if (jacobian)
+    sum.add_point_force(r, f, a, s.rotational);
+  else
+    sum.add_point_force(r, f, s.rotational);
+}
+
+// Skin drag on an area point; m = |u| (read only for quadratic drag).
+[[gnu::always_inline]] inline void add_skin_point(BodySum& sum, Vec2 r, Vec2 u, double m, double k,
+                                                  const DragSettings& s, bool jacobian) {
+  std::array<double, 4> a{};  // dF/du, computed only when the body needs its Jacobian
+  Vec2 f;
+  if (s.reference_speed > 0.0) {
+    f = (k * s.reference_speed) * u;
+    if (jacobian) a = {k * s.reference_speed, 0.0, 0.0, k * s.reference_speed};
+  } else {
+    // dF = k |u| u,  dF/du = k (|u| I + u u^T / |u|).
+    f = (k * m) * u;
+    if (jacobian) {
+      const double inv = m > 0.0 ? 1.0 / m : 0.0;
+      a = {k * (m + u.x * u.x * inv), k * u.x * u.y * inv, k * u.x * u.y * inv, k * (m + u.y * u.y * inv)};
+    }
+  }
+  if (jacobian)
+    sum.add_point_force(r, f, a, s.rotational);
+  else
+    sum.add_point_force(r, f, s.rotational);
+}
+}  // namespace
+
 void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double scale, double c, Vec2 flow, Vec2 v,
                    double w, Rot rot, const DragSettings& s, bool jacobian) {
   for (const EdgePoint& e : edges) {
@@ -43,23 +92,7 @@ void add_form_drag(BodySum& sum, const std::vector<EdgePoint>& edges, double sca
     const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
     const double un = dot(u, n);
     if (un >= 0.0) continue;  // the flow leaves this edge: no pressure on it
-    const double k = c * scale * e.length;
-    std::array<double, 4> a{};  // dF/du, computed only when the body needs its Jacobian
-    Vec2 f;
-    if (s.reference_speed > 0.0) {
-      // Linearised: |u| -> U_ref, so dF = k U_ref cos(theta) u with cos(theta) = -u.n / |u|.
-      const double cos_theta = -un / length(u);
-      f = (k * s.reference_speed * cos_theta) * u;
-      if (jacobian) a = {k * s.reference_speed * cos_theta, 0.0, 0.0, k * s.reference_speed * cos_theta};
-    } else {
-      // dF = k (-u.n) u,  dF/du = k ((-u.n) I - u n^T).
-      f = (-k * un) * u;
-      if (jacobian) a = {k * (-un - u.x * n.x), -k * u.x * n.y, -k * u.y * n.x, k * (-un - u.y * n.y)};
-    }
-    if (jacobian)
-      sum.add_point_force(r, f, a, s.rotational);
-    else
-      sum.add_point_force(r, f, s.rotational);
+    add_form_point(sum, r, n, u, un, c * scale * e.length, s, jacobian);
   }
 }
 
@@ -68,25 +101,7 @@ void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double sc
   for (const AreaPoint& p : points) {
     const Vec2 r = rot.apply(scale * p.r);
     const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
-    const double k = c * scale * scale * p.area;
-    std::array<double, 4> a{};  // dF/du, computed only when the body needs its Jacobian
-    Vec2 f;
-    if (s.reference_speed > 0.0) {
-      f = (k * s.reference_speed) * u;
-      if (jacobian) a = {k * s.reference_speed, 0.0, 0.0, k * s.reference_speed};
-    } else {
-      // dF = k |u| u,  dF/du = k (|u| I + u u^T / |u|).
-      const double m = length(u);
-      f = (k * m) * u;
-      if (jacobian) {
-        const double inv = m > 0.0 ? 1.0 / m : 0.0;
-        a = {k * (m + u.x * u.x * inv), k * u.x * u.y * inv, k * u.x * u.y * inv, k * (m + u.y * u.y * inv)};
-      }
-    }
-    if (jacobian)
-      sum.add_point_force(r, f, a, s.rotational);
-    else
-      sum.add_point_force(r, f, s.rotational);
+    add_skin_point(sum, r, u, s.reference_speed > 0.0 ? 0.0 : length(u), c * scale * scale * p.area, s, jacobian);
   }
 }
 
@@ -94,35 +109,94 @@ DistributedDrag::DistributedDrag(std::string_view name, Kind kind, const Environ
     : name_(name), kind_(kind), settings_{environment.rotational_damping, environment.drag_reference_speed} {}
 
 void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_polygon, std::vector<DragSlab> slabs) {
-  Entry e{body, {}, {}, std::move(slabs), {}};
-  if (kind_ == Kind::form)
-    e.edges = edge_points(local_polygon);
-  else
-    e.points = area_points(local_polygon);
-  // Moments sum |k_p| |r_p|^j (j = 0..3) of each slab's quadrature weights, for the rate bound.
-  for (const DragSlab& slab : e.slabs) {
-    std::array<double, 4> m{};
+  const std::vector<EdgePoint> edges = kind_ == Kind::form ? edge_points(local_polygon) : std::vector<EdgePoint>{};
+  const std::vector<AreaPoint> points = kind_ == Kind::skin ? area_points(local_polygon) : std::vector<AreaPoint>{};
+  const Entry e{body, static_cast<std::uint32_t>(slabs_.size()), static_cast<std::uint32_t>(slabs.size())};
+  for (const DragSlab& drag : slabs) {
+    Slab slab{drag, 0, 0, {}};
+    // Moments sum |k_p| |r_p|^j (j = 0..3) of the slab's quadrature weights, for the rate bound.
     auto add = [&](double k, Vec2 r) {
-      const double d = length(slab.scale * r);
-      m[0] += std::abs(k);
-      m[1] += std::abs(k) * d;
-      m[2] += std::abs(k) * d * d;
-      m[3] += std::abs(k) * d * d * d;
+      const double d = length(drag.scale * r);
+      slab.moments[0] += std::abs(k);
+      slab.moments[1] += std::abs(k) * d;
+      slab.moments[2] += std::abs(k) * d * d;
+      slab.moments[3] += std::abs(k) * d * d * d;
     };
-    for (const EdgePoint& p : e.edges) add(slab.c * slab.scale * p.length, p.r);
-    for (const AreaPoint& p : e.points) add(slab.c * slab.scale * slab.scale * p.area, p.r);
-    e.moments.push_back(m);
+    for (const EdgePoint& p : edges) add(drag.c * drag.scale * p.length, p.r);
+    for (const AreaPoint& p : points) add(drag.c * drag.scale * drag.scale * p.area, p.r);
+    // The packed points, each product as add_form_drag / add_skin_drag form it.
+    if (kind_ == Kind::form) {
+      slab.first = static_cast<std::uint32_t>(form_.size());
+      for (std::size_t k = 0; k + 1 < edges.size(); k += 2)  // edge_points: two per edge
+        form_.push_back({drag.scale * edges[k].r, drag.scale * edges[k + 1].r, edges[k].normal,
+                         drag.c * drag.scale * edges[k].length});
+      slab.count = static_cast<std::uint32_t>(form_.size()) - slab.first;
+    } else {
+      slab.first = static_cast<std::uint32_t>(skin_.size());
+      for (std::size_t k = 0; k + 2 < points.size(); k += 3)  // area_points: a / 2, b / 2, (a + b) / 2
+        skin_.push_back({drag.scale * points[k].r, drag.scale * points[k + 2].r,
+                         drag.c * drag.scale * drag.scale * points[k].area});
+      slab.count = static_cast<std::uint32_t>(skin_.size()) - slab.first;
+    }
+    slabs_.push_back(slab);
   }
   // What the rest test reads, packed: one flow when every slab shares it (a floe's one slab).
-  Quiet q{body, e.slabs.empty() ? Vec2{} : e.slabs.front().flow, true, e.slabs.size() == 1,
-          e.moments.empty() ? std::array<double, 4>{} : e.moments.front()};
-  for (const DragSlab& slab : e.slabs) q.one_flow = q.one_flow && slab.flow.x == q.flow.x && slab.flow.y == q.flow.y;
+  Quiet q{body, slabs.empty() ? Vec2{} : slabs.front().flow, true, slabs.size() == 1,
+          slabs.empty() ? std::array<double, 4>{} : slabs_[e.first_slab].moments};
+  for (const DragSlab& slab : slabs) q.one_flow = q.one_flow && slab.flow.x == q.flow.x && slab.flow.y == q.flow.y;
   quiet_.push_back(q);
-  for (const DragSlab& slab : e.slabs) calm_ = calm_ && slab.flow.x == 0.0 && slab.flow.y == 0.0;
+  for (const DragSlab& slab : slabs) calm_ = calm_ && slab.flow.x == 0.0 && slab.flow.y == 0.0;
   if (kind_ == Kind::skin && settings_.reference_speed > 0.0) calm_ = false;
   if (entry_of_body_.size() <= body) entry_of_body_.resize(body + 1, -1);
   entry_of_body_[body] = static_cast<std::int32_t>(entries_.size());
-  entries_.push_back(std::move(e));
+  entries_.push_back(e);
+}
+
+void DistributedDrag::add_form_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const {
+  // add_form_drag, point by point in its order, each edge's normal turned once.
+  const Vec2 flow = slab.drag.flow;
+  const DragSettings& s = settings_;
+  auto point = [&](Vec2 local, Vec2 n, double k) {
+    const Vec2 r = rot.apply(local);
+    const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
+    const double un = dot(u, n);
+    if (un >= 0.0) return;  // the flow leaves this edge: no pressure on it
+    add_form_point(sum, r, n, u, un, k, s, jacobian);
+  };
+  const FormEdge* edge = form_.data() + slab.first;
+  for (std::uint32_t j = 0; j < slab.count; ++j) {
+    const Vec2 n = rot.apply(edge[j].normal);
+    point(edge[j].first, n, edge[j].weight);
+    point(edge[j].second, n, edge[j].weight);
+  }
+}
+
+void DistributedDrag::add_skin_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const {
+  // add_skin_drag, point by point in its order; the relative velocity and its magnitude at a
+  // half-vertex serve both triangles that share it.
+  const Vec2 flow = slab.drag.flow;
+  const DragSettings& s = settings_;
+  struct Local {
+    Vec2 r, u;
+    double m;  // |u| (quadratic drag)
+  };
+  auto at = [&](Vec2 local) {
+    const Vec2 r = rot.apply(local);
+    const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
+    return Local{r, u, s.reference_speed > 0.0 ? 0.0 : length(u)};
+  };
+  auto add = [&](const Local& p, double k) { add_skin_point(sum, p.r, p.u, p.m, k, s, jacobian); };
+  if (slab.count == 0) return;
+  const SkinTriangle* t = skin_.data() + slab.first;
+  const Local first = at(t[0].half_vertex);
+  Local a = first;
+  for (std::uint32_t j = 0; j < slab.count; ++j) {
+    const Local b = j + 1 < slab.count ? at(t[j + 1].half_vertex) : first;
+    add(a, t[j].weight);
+    add(b, t[j].weight);
+    add(at(t[j].middle), t[j].weight);
+    a = b;
+  }
 }
 
 template <class F>
@@ -178,7 +252,10 @@ void DistributedDrag::add_entry_bound(std::size_t i, const BodyStates& s, ForceS
     return;
   }
   const Entry& e = entries_[i];
-  for (std::size_t k = 0; k < e.slabs.size(); ++k) add_slab(e.moments[k], e.slabs[k].flow);
+  for (std::uint32_t k = 0; k < e.slab_count; ++k) {
+    const Slab& slab = slabs_[e.first_slab + k];
+    add_slab(slab.moments, slab.drag.flow);
+  }
 }
 
 bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
@@ -190,8 +267,11 @@ bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
   if (w != 0.0 || (kind_ == Kind::skin && settings_.reference_speed > 0.0)) return false;
   const Quiet& q = quiet_[i];
   if (q.one_flow) return q.flow.x == v.x && q.flow.y == v.y;
-  for (const DragSlab& slab : entries_[i].slabs)
-    if (slab.flow.x != v.x || slab.flow.y != v.y) return false;
+  const Entry& e = entries_[i];
+  for (std::uint32_t k = 0; k < e.slab_count; ++k) {
+    const Vec2 flow = slabs_[e.first_slab + k].drag.flow;
+    if (flow.x != v.x || flow.y != v.y) return false;
+  }
   return true;
 }
 
@@ -215,11 +295,12 @@ bool DistributedDrag::add_entry(std::size_t i, const BodyStates& s, ForceSums& s
   const Rot rot = sums.rotation[e.body];
   const bool jacobian = sums.jacobian[e.body] != 0;
   BodySum sum = sums.load(e.body);
-  for (const DragSlab& slab : e.slabs) {
+  for (std::uint32_t k = 0; k < e.slab_count; ++k) {
+    const Slab& slab = slabs_[e.first_slab + k];
     if (kind_ == Kind::form)
-      add_form_drag(sum, e.edges, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
+      add_form_slab(sum, slab, v, w, rot, jacobian);
     else
-      add_skin_drag(sum, e.points, slab.scale, slab.c, slab.flow, v, w, rot, settings_, jacobian);
+      add_skin_slab(sum, slab, v, w, rot, jacobian);
   }
   sums.store(e.body, sum);
   return jacobian;

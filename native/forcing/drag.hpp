@@ -35,6 +35,8 @@ struct DragSettings {
   double reference_speed = 0.0;  ///< > 0: |u| replaced by this (linearised drag)
 };
 
+/// The quadrature point by point: the rule that DistributedDrag evaluates in packed form, and
+/// the reference the tests hold it to (the same sums to the bit).
 /// `jacobian` false: Q alone (the body cannot be stiff this step), the same Q to the bit.
 /// Adds form drag of a slab (height h, outline scaled by s) in the flow V: coefficient
 /// c = 1/2 rho C h.
@@ -67,13 +69,33 @@ class DistributedDrag final : public ForceTerm {
   bool reads_stirred() const override { return calm_; }
 
  private:
+  // Packed quadrature, read every step: the same points, weights and order as edge_points /
+  // area_points with add_form_drag / add_skin_drag (the same sums to the bit, tested), with
+  // each slab's scale and coefficient folded into its points (weight = c s l / 2 for an edge
+  // point, c s^2 A / 3 for an area point, in the order those functions multiply them), an
+  // edge's normal turned once for its two Gauss points, and the half-vertex that two
+  // triangles of the centroid fan share evaluated once.
+  struct FormEdge {
+    Vec2 first, second;  // the two Gauss points, scaled, body frame
+    Vec2 normal;         // outward, body frame
+    double weight;       // c s l / 2: each point's share
+  };
+  struct SkinTriangle {
+    Vec2 half_vertex;  // s a_k / 2, shared with the previous triangle (its s a_{k+1} / 2)
+    Vec2 middle;       // s (a_k + a_{k+1}) / 2
+    double weight;     // c s^2 cross(a_k, a_{k+1}) / 6: each of the three points' share
+  };
+  struct Slab {
+    DragSlab drag;
+    std::uint32_t first = 0, count = 0;  // its edges in form_ or triangles in skin_
+    std::array<double, 4> moments{};     // sum |k| |r|^j, j = 0..3 (rate bound)
+  };
   struct Entry {
     std::size_t body;
-    std::vector<EdgePoint> edges;   // form drag
-    std::vector<AreaPoint> points;  // skin drag
-    std::vector<DragSlab> slabs;
-    std::vector<std::array<double, 4>> moments;  // per slab: sum |k| |r|^j, j = 0..3 (rate bound)
+    std::uint32_t first_slab, slab_count;  // in slabs_
   };
+  void add_form_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const;
+  void add_skin_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const;
   /// Entry i's body moves with every slab's flow, without spin: it adds nothing (see drag.cpp).
   bool adds_nothing(std::size_t i, Vec2 v, double w) const;
   /// Entry i's force (and Jacobian where its body needs one); returns whether it added a Jacobian.
@@ -96,6 +118,9 @@ class DistributedDrag final : public ForceTerm {
   Kind kind_;
   DragSettings settings_;
   std::vector<Entry> entries_;
+  std::vector<Slab> slabs_;
+  std::vector<FormEdge> form_;
+  std::vector<SkinTriangle> skin_;
   std::vector<Quiet> quiet_;  // per entry, what adds_nothing reads (kept apart: read every step)
   // Every slab's flow is zero (and the drag is not linearised skin drag, which acts at u = 0):
   // a body at rest adds exactly nothing (adds_nothing), so only moving bodies are visited.

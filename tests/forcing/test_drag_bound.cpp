@@ -1,4 +1,5 @@
-// The drag terms' shortcuts must not change a result: the rate bound that lets a body skip its
+// The drag terms' shortcuts must not change a result: the packed quadrature the terms evaluate
+// gives the point-by-point rule's sums to the bit, the rate bound that lets a body skip its
 // Jacobian is a true upper bound of what stiff() reads (forcing.cpp), and Q without the
 // Jacobian is Q with it, to the bit.
 #include <catch2/catch.hpp>
@@ -27,7 +28,8 @@ ForceSums sums_for(std::size_t n) {
 
 }  // namespace
 
-TEST_CASE("drag: the rate bound covers the Jacobian, and Q is the same without it", "[forcing]") {
+TEST_CASE("drag: the packed quadrature is the rule to the bit and the rate bound covers the Jacobian",
+          "[forcing]") {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int cases = 0;
@@ -50,8 +52,10 @@ TEST_CASE("drag: the rate bound covers the Jacobian, and Q is the same without i
           }
           const Vec2 c = area_moments(poly).centroid;
           for (Vec2& p : poly) p = p - c;
-          drag.add_body(0, poly, {{500.0 * (1.0 + u(rng)), 0.5 + u(rng) * 0.4, {u(rng), u(rng)}},
-                                  {3.0 * (1.0 + u(rng)), 1.0, {10.0 * u(rng), 10.0 * u(rng)}}});
+          if (trial % 7 == 3) poly.insert(poly.begin() + 2, poly[2]);  // a zero-length edge
+          const std::vector<DragSlab> slabs{{500.0 * (1.0 + u(rng)), 0.5 + u(rng) * 0.4, {u(rng), u(rng)}},
+                                            {3.0 * (1.0 + u(rng)), 1.0, {10.0 * u(rng), 10.0 * u(rng)}}};
+          drag.add_body(0, poly, slabs);
           BodyStates s;
           s.resize(1);
           s.velocity[0] = {2.0 * u(rng), 2.0 * u(rng)};
@@ -61,6 +65,19 @@ TEST_CASE("drag: the rate bound covers the Jacobian, and Q is the same without i
           ForceSums full = sums_for(1);
           full.rotation[0] = Rot::from_angle(s.angle[0]);
           drag.add(s, 0.0, full);
+          // The term's packed quadrature gives the point-by-point rule's sums to the bit.
+          BodySum rule{};
+          for (const DragSlab& slab : slabs) {
+            const DragSettings settings{rotational, reference_speed};
+            if (kind == DistributedDrag::Kind::form)
+              add_form_drag(rule, edge_points(poly), slab.scale, slab.c, slab.flow, s.velocity[0],
+                            s.angular_velocity[0], full.rotation[0], settings, true);
+            else
+              add_skin_drag(rule, area_points(poly), slab.scale, slab.c, slab.flow, s.velocity[0],
+                            s.angular_velocity[0], full.rotation[0], settings, true);
+          }
+          CHECK(full.q[0] == rule.q);
+          CHECK(full.dq[0] == rule.d);
           REQUIRE(drag.add_rate_bound(s, full));
           const auto& d = full.dq[0];
           const double rows = std::max(std::abs(d[0]) + std::abs(d[1]), std::abs(d[3]) + std::abs(d[4]));
