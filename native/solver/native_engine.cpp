@@ -500,7 +500,12 @@ void NativeEngine::build_manifolds() {
   thread_pool().for_blocks(pairs_.size(), 512, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       if (may_reuse && reuse_[k] >= 0) {
-        narrow_[k] = previous_narrow_[static_cast<std::size_t>(reuse_[k])];
+        const Manifold& was = previous_narrow_[static_cast<std::size_t>(reuse_[k])];
+        // A pair without contact is read for its point count alone (most pairs of fat boxes).
+        if (was.point_count == 0)
+          narrow_[k].point_count = 0;
+        else
+          narrow_[k] = was;
         continue;
       }
       const PartPair pair = pairs_[k];
