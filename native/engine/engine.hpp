@@ -31,6 +31,18 @@ struct BodyStates {
   }
 };
 
+/// Read-only view of BodyStates whose arrays may come from different places: the forcing
+/// terms see the engine's positions with the velocities a towed body will have over the step,
+/// without a copy of the whole state.
+struct BodyStatesView {
+  std::span<const Vec2> position;
+  std::span<const double> angle;
+  std::span<const Vec2> velocity;
+  std::span<const double> angular_velocity;
+  BodyStatesView(const BodyStates& s)  // NOLINT(google-explicit-constructor): a view of it
+      : position(s.position), angle(s.angle), velocity(s.velocity), angular_velocity(s.angular_velocity) {}
+};
+
 /// A body moved on a prescribed velocity over the step (towing at constant speed): the engine
 /// treats it as kinematic (infinite mass in contacts) and moves it by dt times this velocity.
 struct PrescribedMotion {

@@ -17,8 +17,8 @@ class AppliedLoad final : public ForceTerm {
   }
   bool empty() const { return loaded_.empty(); }
   std::string_view name() const override { return "applied_load"; }
-  bool add_rate_bound(const BodyStates&, ForceSums&) const override { return true; }  // no Jacobian
-  void add(const BodyStates&, double, ForceSums& sums) const override {
+  bool add_rate_bound(const BodyStatesView&, ForceSums&) const override { return true; }  // no Jacobian
+  void add(const BodyStatesView&, double, ForceSums& sums) const override {
     for (const Entry& e : loaded_) sums.add_force(e.body, e.force, e.torque);
   }
 

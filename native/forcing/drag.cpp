@@ -217,12 +217,12 @@ void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& 
   });
 }
 
-bool DistributedDrag::add_rate_bound(const BodyStates& s, ForceSums& sums) const {
+bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) const {
   for_entries(sums, 4096, [&](std::size_t i) { add_entry_bound(i, s, sums); });
   return true;
 }
 
-void DistributedDrag::add_entry_bound(std::size_t i, const BodyStates& s, ForceSums& sums) const {
+void DistributedDrag::add_entry_bound(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {
   // Per quadrature point, with m = |u| <= |V - v| + |w| |r| and k its weight (MODEL.md 2):
   //   skin  a = k (m I + u u^T / m):    |a_00| + |a_01| <= (1 + sqrt 2) |k| m,  g^T a g <= 2 |k| m |r|^2
   //   form  a = k (-(u.n) I - u n^T):   the same two bounds (|u.n| <= m, |n_x| + |n_y| <= sqrt 2)
@@ -275,7 +275,7 @@ bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
   return true;
 }
 
-void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
+void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) const {
   // Entries are bodies, one each: blocks of them on the pool's threads write distinct bodies,
   // each in the same order as one thread would, so the sums do not depend on the threads.
   std::atomic<bool> any_jacobian{false};
@@ -286,7 +286,7 @@ void DistributedDrag::add(const BodyStates& s, double, ForceSums& sums) const {
   if (any_jacobian.load(std::memory_order_relaxed)) sums.any_jacobian = true;
 }
 
-bool DistributedDrag::add_entry(std::size_t i, const BodyStates& s, ForceSums& sums) const {
+bool DistributedDrag::add_entry(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {
   const std::size_t body = quiet_[i].body;
   const Vec2 v = s.velocity[body];
   const double w = s.angular_velocity[body];

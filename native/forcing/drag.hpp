@@ -64,8 +64,8 @@ class DistributedDrag final : public ForceTerm {
   void add_body(std::size_t body, const std::vector<Vec2>& local_polygon, std::vector<DragSlab> slabs);
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return name_; }
-  void add(const BodyStates& state, double time, ForceSums& sums) const override;
-  bool add_rate_bound(const BodyStates& state, ForceSums& sums) const override;
+  void add(const BodyStatesView& state, double time, ForceSums& sums) const override;
+  bool add_rate_bound(const BodyStatesView& state, ForceSums& sums) const override;
   bool reads_stirred() const override { return calm_; }
 
  private:
@@ -99,8 +99,8 @@ class DistributedDrag final : public ForceTerm {
   /// Entry i's body moves with every slab's flow, without spin: it adds nothing (see drag.cpp).
   bool adds_nothing(std::size_t i, Vec2 v, double w) const;
   /// Entry i's force (and Jacobian where its body needs one); returns whether it added a Jacobian.
-  bool add_entry(std::size_t i, const BodyStates& state, ForceSums& sums) const;
-  void add_entry_bound(std::size_t i, const BodyStates& state, ForceSums& sums) const;
+  bool add_entry(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
+  void add_entry_bound(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   /// Calls f(i) for each entry that may add something: every entry, or in still water and air
   /// (calm_) only those of the bodies that move (ForceSums::stirred), in blocks of `grain` on
   /// the pool's threads.

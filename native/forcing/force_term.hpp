@@ -105,12 +105,12 @@ class ForceTerm {
   virtual ~ForceTerm() = default;
   virtual std::string_view name() const = 0;
   /// Adds this term at the start of a step at `time`.
-  virtual void add(const BodyStates& state, double time, ForceSums& sums) const = 0;
+  virtual void add(const BodyStatesView& state, double time, ForceSums& sums) const = 0;
   /// Adds to sums.rate_bound, per body, upper bounds of what this term adds to the row sums
   /// max(|D_xx| + |D_xy|, |D_yx| + |D_yy|) and to |D_ww| of the Jacobian at this state, and
   /// returns true; or returns false when it cannot bound them (then every body gets the full
   /// Jacobian). A term that adds no Jacobian returns true and adds nothing.
-  virtual bool add_rate_bound(const BodyStates&, ForceSums&) const { return false; }
+  virtual bool add_rate_bound(const BodyStatesView&, ForceSums&) const { return false; }
   /// True for a term that only adds a constant rotation rate (Coriolis): a scene whose terms
   /// are all such takes a precomputed per-body path (Forcing::evaluate).
   virtual bool constant_rotation_only() const { return false; }
@@ -144,7 +144,10 @@ class Forcing {
   double dt_;
   ForceSums sums_;
   Loads loads_;
-  BodyStates moved_;  ///< the state with prescribed velocities (towing scenes only)
+  /// The velocities with the prescribed ones (towing scenes only): the terms see these with the
+  /// engine's positions and angles.
+  std::vector<Vec2> moved_velocity_;
+  std::vector<double> moved_angular_velocity_;
   std::vector<double> rotated_angle_;  ///< the angle sums_.rotation[i] was computed for
   std::vector<double> cached_rate_, cached_tan_, cached_half_tan_;  ///< Coriolis turn per body
   struct BodyHot {

@@ -55,8 +55,8 @@ std::array<double, 3> Forcing::environment_force(std::size_t i) const {
   std::array<double, 3> q = sums_.q[i];
   if (sums_.any_rotation && scene_.bodies[i].prescribed) {
     const double mf = scene_.bodies[i].mass * sums_.rotation_rate[i];
-    q[0] += mf * moved_.velocity[i].y;
-    q[1] -= mf * moved_.velocity[i].x;
+    q[0] += mf * moved_velocity_[i].y;
+    q[1] -= mf * moved_velocity_[i].x;
   }
   return q;
 }
@@ -150,24 +150,27 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
     return &loads_;
   }
   // A prescribed body feels the forcing at the velocity it will have over the step.
-  const BodyStates* at = &state;
+  // Only the velocities are copied (the terms read positions and angles from the state).
+  BodyStatesView at = state;
   if (!prescribed_.empty()) {
-    moved_ = state;
+    moved_velocity_.assign(state.velocity.begin(), state.velocity.end());
+    moved_angular_velocity_.assign(state.angular_velocity.begin(), state.angular_velocity.end());
     for (const PrescribedMotion& p : loads_.prescribed) {
-      moved_.velocity[p.body] = p.velocity;
-      moved_.angular_velocity[p.body] = p.angular_velocity;
+      moved_velocity_[p.body] = p.velocity;
+      moved_angular_velocity_[p.body] = p.angular_velocity;
     }
-    at = &moved_;
+    at.velocity = moved_velocity_;
+    at.angular_velocity = moved_angular_velocity_;
   }
 
   sums_.stirred.clear();
   for (std::size_t i = 0; i < hot_.size(); ++i) {
-    if (at->angle[i] != rotated_angle_[i]) {  // the body turned (or the first step)
-      sums_.rotation[i] = Rot::from_angle(at->angle[i]);
-      rotated_angle_[i] = at->angle[i];
+    if (at.angle[i] != rotated_angle_[i]) {  // the body turned (or the first step)
+      sums_.rotation[i] = Rot::from_angle(at.angle[i]);
+      rotated_angle_[i] = at.angle[i];
     }
-    const Vec2 v = at->velocity[i];
-    if (list_stirred_ && (v.x != 0.0 || v.y != 0.0 || at->angular_velocity[i] != 0.0))
+    const Vec2 v = at.velocity[i];
+    if (list_stirred_ && (v.x != 0.0 || v.y != 0.0 || at.angular_velocity[i] != 0.0))
       sums_.stirred.push_back(static_cast<std::int32_t>(i));
   }
   // Which bodies need D: where the terms' bound on dt |D| / M stays below the explicit limit,
@@ -175,7 +178,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
   // skip its nine products per quadrature point). The margin covers rounding in the sums.
   std::fill(sums_.rate_bound.begin(), sums_.rate_bound.end(), std::array<double, 2>{});
   bool bounded = true;
-  for (const auto& t : terms_) bounded = t->add_rate_bound(*at, sums_) && bounded;
+  for (const auto& t : terms_) bounded = t->add_rate_bound(at, sums_) && bounded;
   for (std::size_t i = 0; i < hot_.size(); ++i) {
     const BodyHot& h = hot_[i];
     const std::array<double, 2>& b = sums_.rate_bound[i];
@@ -190,7 +193,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
   if (sums_.any_jacobian) std::fill(sums_.dq.begin(), sums_.dq.end(), std::array<double, 9>{});
   if (sums_.any_rotation) std::fill(sums_.rotation_rate.begin(), sums_.rotation_rate.end(), 0.0);
   sums_.any_jacobian = sums_.any_rotation = false;
-  for (const auto& t : terms_) t->add(*at, time, sums_);
+  for (const auto& t : terms_) t->add(at, time, sums_);
 
   const std::size_t n = hot_.size();
   const bool first_step = time == 0.0;
@@ -207,13 +210,19 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
       const double ii = h.inertia_with_added;
       const std::array<double, 3>& q = sums_.q[i];
       std::array<double, 3> dv;
-      const double f = sums_.any_rotation ? sums_.rotation_rate[i] * h.mass / mi : 0.0;
       const bool implicit = sums_.any_jacobian && stiff(sums_.dq[i], mi, ii);
       // A body no term pushed (Q = +0), explicit, that Coriolis cannot turn (at rest, or no
       // rotation) gets no load: the paths below give +0 to the bit (rhs = +0 whatever the sign
-      // of a zero velocity), here without their divisions. Most floes of the towing case.
-      if (!implicit && plus_zero(q[0]) && plus_zero(q[1]) && plus_zero(q[2]) &&
-          (f == 0.0 || (state.velocity[i].x == 0.0 && state.velocity[i].y == 0.0))) {
+      // of a zero velocity), here without their divisions (the rotation rate's too, when the
+      // body is at rest). Most floes of the towing case.
+      const bool unpushed = !implicit && plus_zero(q[0]) && plus_zero(q[1]) && plus_zero(q[2]);
+      if (unpushed && state.velocity[i].x == 0.0 && state.velocity[i].y == 0.0) {
+        loads_.force[i] = {};
+        loads_.torque[i] = 0.0;
+        continue;
+      }
+      const double f = sums_.any_rotation ? sums_.rotation_rate[i] * h.mass / mi : 0.0;
+      if (unpushed && f == 0.0) {
         loads_.force[i] = {};
         loads_.torque[i] = 0.0;
         continue;

@@ -16,7 +16,7 @@ class RopeTow final : public ForceTerm {
  public:
   explicit RopeTow(const Scene& scene) : tow_(scene.tow), dt_(scene.run.dt) {}
   std::string_view name() const override { return "rope_tow"; }
-  void add(const BodyStates& s, double time, ForceSums& sums) const override {
+  void add(const BodyStatesView& s, double time, ForceSums& sums) const override {
     const RopeState r = rope_state(tow_, s, time);
     if (r.tension <= 0.0) return;
     const double k = tow_.damping + dt_ * tow_.stiffness;

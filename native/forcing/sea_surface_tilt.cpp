@@ -31,8 +31,8 @@ class SeaSurfaceTilt final : public ForceTerm {
   }
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return "sea_surface_tilt"; }
-  bool add_rate_bound(const BodyStates&, ForceSums&) const override { return true; }  // no Jacobian
-  void add(const BodyStates&, double, ForceSums& sums) const override {
+  bool add_rate_bound(const BodyStatesView&, ForceSums&) const override { return true; }  // no Jacobian
+  void add(const BodyStatesView&, double, ForceSums& sums) const override {
     for (const Entry& e : entries_) sums.add_force(e.body, e.force, 0.0);
   }
 

@@ -24,8 +24,8 @@ class WaveRadiation final : public ForceTerm {
   }
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return "wave_radiation"; }
-  bool add_rate_bound(const BodyStates&, ForceSums&) const override { return true; }  // no Jacobian
-  void add(const BodyStates&, double, ForceSums& sums) const override {
+  bool add_rate_bound(const BodyStatesView&, ForceSums&) const override { return true; }  // no Jacobian
+  void add(const BodyStatesView&, double, ForceSums& sums) const override {
     for (const Entry& e : entries_) {
       // Facing length = extent of the polygon across the wave direction.
       const Vec2 across = sums.rotation[e.body].apply_inverse(perp(direction_));

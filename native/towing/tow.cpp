@@ -6,7 +6,7 @@
 
 namespace floedem {
 
-RopeState rope_state(const TowSpec& tow, const BodyStates& s, double t) {
+RopeState rope_state(const TowSpec& tow, const BodyStatesView& s, double t) {
   RopeState r;
   r.tug = tow.tug_start + tow.displacement(0.0, t);
   const std::size_t i = tow.body;

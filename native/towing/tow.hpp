@@ -17,7 +17,7 @@ struct RopeState {
 };
 
 /// The rope at time t for the body state s (tow.mode must be rope).
-RopeState rope_state(const TowSpec& tow, const BodyStates& s, double t);
+RopeState rope_state(const TowSpec& tow, const BodyStatesView& s, double t);
 
 /// What the recorder writes per frame: the step's towing force, and the means over the frame's
 /// steps of the towing force and of its ice part.
