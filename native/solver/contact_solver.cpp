@@ -177,9 +177,11 @@ int run_sweeps(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, 
     if (momentum->direction.capacity() < n) {
       momentum->change.reserve(n + n / 2);
       momentum->direction.reserve(n + n / 2);
+      momentum->step.reserve(n + n / 2);
     }
     momentum->change.assign(n, 0.0);  // a manifold's absent second point stays 0
     momentum->direction.assign(n, 0.0);
+    momentum->step.resize(n);
   }
   double previous_size = 0.0;  // |r_k|^2; 0 before the first sweep
   int max_iterations = limits.iterations;
@@ -226,12 +228,17 @@ int run_sweeps(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, 
       std::fill(p.begin(), p.end(), 0.0);  // the merit rose: restart
     } else {
       const double beta = previous_size > 0.0 ? size / previous_size : 0.0;
-      // Over the dense arrays: a point that neither moved nor carries a direction (a
-      // speculative contact kept apart, an absent second point) costs no look at its manifold.
+      // Over the dense arrays, in two passes: the step beta p and the new direction (a loop
+      // the compiler vectorises), then the step applied where it is not zero: a point that
+      // neither moved nor carries a direction (a speculative contact kept apart, an absent
+      // second point) costs no look at its manifold.
+      std::vector<double>& step = momentum->step;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        step[i] = beta * p[i];
+        p[i] = step[i] + r[i];
+      }
       for (std::size_t i = 0; i < p.size(); i += 2) {
-        const double sn = beta * p[i], st = beta * p[i + 1];
-        p[i] = sn + r[i];
-        p[i + 1] = st + r[i + 1];
+        const double sn = step[i], st = step[i + 1];
         if (sn == 0.0 && st == 0.0) continue;
         const Manifold& m = manifolds[i / 4];
         ManifoldPoint& q = manifolds[i / 4].points[(i / 2) % 2];

@@ -56,6 +56,7 @@ inline void warm_start(std::span<const Manifold> manifolds, BodyArrays& bodies) 
 struct SweepMomentum {
   std::vector<double> change;     ///< per point (n, t): the impulse change of the last sweep
   std::vector<double> direction;  ///< per point (n, t): the conjugate direction p
+  std::vector<double> step;       ///< per point (n, t): beta p, the impulse the step adds
 };
 
 /// How long the sweeps go on.
