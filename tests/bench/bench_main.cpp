@@ -7,7 +7,9 @@
 
 #include "engine/registry.hpp"
 #include "field/field_generator.hpp"
+#include "forcing/drag.hpp"
 #include "forcing/force_term.hpp"
+#include "geometry/polygon.hpp"
 #include "scenario/scenario.hpp"
 #include "solver/broad_phase.hpp"
 
@@ -87,6 +89,68 @@ void BM_StepFullEnvironment(benchmark::State& state) {
 BENCHMARK(BM_StepNoEnvironment)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_StepCoriolisOnly)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_StepFullEnvironment)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
+/// Drag quadrature (a third of a step in a drifting field): N floes, 5 to 9 corners, 5 to 30 m,
+/// drifting and turning in a current, water form and skin drag. Arg(1): the terms' packed
+/// quadrature (drag.cpp); Arg(0): the point-by-point rule it reproduces to the bit, over point
+/// lists made once per floe (as the terms held them before they were packed).
+void BM_DragQuadrature(benchmark::State& state) {
+  const bool packed = state.range(0) != 0;
+  const int n = 1000;
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  EnvironmentSpec env;
+  DistributedDrag form("form", DistributedDrag::Kind::form, env), skin("skin", DistributedDrag::Kind::skin, env);
+  std::vector<std::vector<EdgePoint>> edges;  // the rule's points, made once as the terms' were
+  std::vector<std::vector<AreaPoint>> points;
+  BodyStates s;
+  s.resize(n);
+  ForceSums sums;
+  sums.q.assign(n, {});
+  sums.dq.assign(n, {});
+  sums.rotation_rate.assign(n, 0.0);
+  sums.jacobian.assign(n, 0);  // floes of a field: never stiff, Q alone
+  sums.rate_bound.assign(n, {});
+  const Vec2 current{0.3, 0.1};
+  for (int i = 0; i < n; ++i) {
+    const int corners = 5 + i % 5;
+    const double size = 2.5 + 12.5 * (1.0 + u(rng)) / 2.0;
+    std::vector<Vec2> poly;
+    for (int k = 0; k < corners; ++k) {
+      const double a = 2.0 * M_PI * (k + 0.3 * u(rng)) / corners;
+      poly.push_back({size * std::cos(a), size * std::sin(a)});
+    }
+    const Vec2 c = area_moments(poly).centroid;
+    for (Vec2& p : poly) p = p - c;
+    form.add_body(static_cast<std::size_t>(i), poly, {{0.5 * 1025.0 * 0.6 * 1.0, 1.0, current}});
+    skin.add_body(static_cast<std::size_t>(i), poly, {{1025.0 * 0.0055, 1.0, current}});
+    edges.push_back(edge_points(poly));
+    points.push_back(area_points(poly));
+    s.velocity[i] = {0.2 + 0.1 * u(rng), 0.1 * u(rng)};
+    s.angular_velocity[i] = 0.01 * u(rng);
+    sums.rotation.push_back(Rot::from_angle(u(rng)));
+  }
+  const DragSettings settings{env.rotational_damping, env.drag_reference_speed};
+  for (auto _ : state) {
+    if (packed) {
+      form.add(s, 0.0, sums);
+      skin.add(s, 0.0, sums);
+    } else {
+      for (int i = 0; i < n; ++i) {
+        BodySum sum = sums.load(static_cast<std::size_t>(i));
+        add_form_drag(sum, edges[i], 1.0, 0.5 * 1025.0 * 0.6, current, s.velocity[i],
+                      s.angular_velocity[i], sums.rotation[i], settings, false);
+        add_skin_drag(sum, points[i], 1.0, 1025.0 * 0.0055, current, s.velocity[i],
+                      s.angular_velocity[i], sums.rotation[i], settings, false);
+        sums.store(static_cast<std::size_t>(i), sum);
+      }
+    }
+    benchmark::DoNotOptimize(sums.q.data());
+  }
+  state.counters["ns_per_floe"] =
+      benchmark::Counter(n, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_DragQuadrature)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 /// Field generation (issue 4's targets: 1e4 floes under 2 s, 1e5 under 20 s on 2 cores):
 /// alpha 2, d 2..50 m, C 0.5, default irregularity; the square domain holds N floes.
