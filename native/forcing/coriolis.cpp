@@ -15,6 +15,7 @@ class Coriolis final : public ForceTerm {
   }
   std::string_view name() const override { return "coriolis"; }
   bool constant_rotation_only() const override { return true; }
+  bool idle_at_rest() const override { return true; }  // a rotation rate alone
   bool add_rate_bound(const BodyStatesView&, ForceSums&) const override { return true; }  // no Jacobian
   void add(const BodyStatesView&, double, ForceSums& sums) const override {
     for (const std::size_t i : bodies_) sums.rotation_rate[i] += f_;

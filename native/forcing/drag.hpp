@@ -67,6 +67,7 @@ class DistributedDrag final : public ForceTerm {
   void add(const BodyStatesView& state, double time, ForceSums& sums) const override;
   bool add_rate_bound(const BodyStatesView& state, ForceSums& sums) const override;
   bool reads_stirred() const override { return calm_; }
+  bool idle_at_rest() const override { return calm_; }
 
  private:
   // Packed quadrature, read every step: the same points, weights and order as edge_points /

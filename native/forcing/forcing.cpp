@@ -84,7 +84,9 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
   sums_.jacobian.assign(n, 1);
   sums_.rate_bound.resize(n);
   list_stirred_ = std::any_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->reads_stirred(); });
+  moving_only_ = list_stirred_ && std::all_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->idle_at_rest(); });
   if (list_stirred_) sums_.stirred.reserve(n);
+  if (moving_only_) dirty_.reserve(n);
   rotated_angle_.assign(n, std::numeric_limits<double>::quiet_NaN());  // NaN: none computed yet
   cached_rate_.assign(n, 0.0);
   cached_tan_.assign(n, 0.0);
@@ -173,95 +175,126 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
     if (list_stirred_ && (v.x != 0.0 || v.y != 0.0 || at.angular_velocity[i] != 0.0))
       sums_.stirred.push_back(static_cast<std::int32_t>(i));
   }
+  // Moving bodies alone (moving_only_): every term is idle at rest, so a body at rest gets
+  // Q = +0, no Jacobian and no rate bound, hence no load (load_body's first skip), and its
+  // entries stay as the full path would set them once those the last step wrote are zeroed.
+  // The same sums and loads to the bit.
+  const bool sparse = moving_only_ && have_dirty_;
+  const std::span<const std::int32_t> moving = sums_.stirred;
+  if (sparse) {
+    for (const std::int32_t i : dirty_) {
+      sums_.rate_bound[i] = {};
+      sums_.q[i] = {};
+      if (sums_.any_jacobian) sums_.dq[i] = {};
+      loads_.force[i] = {};
+      loads_.torque[i] = 0.0;
+    }
+  }
   // Which bodies need D: where the terms' bound on dt |D| / M stays below the explicit limit,
   // stiff() would find the body explicit whatever D is, so D is not computed (the terms then
   // skip its nine products per quadrature point). The margin covers rounding in the sums.
-  std::fill(sums_.rate_bound.begin(), sums_.rate_bound.end(), std::array<double, 2>{});
+  if (!sparse) std::fill(sums_.rate_bound.begin(), sums_.rate_bound.end(), std::array<double, 2>{});
   bool bounded = true;
   for (const auto& t : terms_) bounded = t->add_rate_bound(at, sums_) && bounded;
-  for (std::size_t i = 0; i < hot_.size(); ++i) {
+  auto needs_jacobian = [&](std::size_t i) {
     const BodyHot& h = hot_[i];
     const std::array<double, 2>& b = sums_.rate_bound[i];
     if (b[0] == 0.0 && b[1] == 0.0) {  // nothing bounded here (a body at rest in still water): rate 0
       sums_.jacobian[i] = !bounded;
-      continue;
+      return;
     }
     const double rate = std::max(b[0] / h.mass_with_added, b[1] / h.inertia_with_added);
     sums_.jacobian[i] = !bounded || (h.moves && dt_ * rate * (1.0 + 1e-6) > kExplicitLimit);
+  };
+  if (sparse) {
+    for (const std::int32_t i : moving) needs_jacobian(static_cast<std::size_t>(i));
+  } else {
+    for (std::size_t i = 0; i < hot_.size(); ++i) needs_jacobian(i);
+    std::fill(sums_.q.begin(), sums_.q.end(), std::array<double, 3>{});
+    if (sums_.any_jacobian) std::fill(sums_.dq.begin(), sums_.dq.end(), std::array<double, 9>{});
   }
-  std::fill(sums_.q.begin(), sums_.q.end(), std::array<double, 3>{});
-  if (sums_.any_jacobian) std::fill(sums_.dq.begin(), sums_.dq.end(), std::array<double, 9>{});
   if (sums_.any_rotation) std::fill(sums_.rotation_rate.begin(), sums_.rotation_rate.end(), 0.0);
   sums_.any_jacobian = sums_.any_rotation = false;
   for (const auto& t : terms_) t->add(at, time, sums_);
 
-  const std::size_t n = hot_.size();
   const bool first_step = time == 0.0;
   // Per body, independent: blocks on the pool's threads (the same result on any number).
-  thread_pool().for_blocks(n, 2048, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const BodyHot& h = hot_[i];
-      if (!h.moves) {
-        loads_.force[i] = {};
-        loads_.torque[i] = 0.0;
-        continue;
-      }
-      const double mi = h.mass_with_added;
-      const double ii = h.inertia_with_added;
-      const std::array<double, 3>& q = sums_.q[i];
-      std::array<double, 3> dv;
-      const bool implicit = sums_.any_jacobian && stiff(sums_.dq[i], mi, ii);
-      // A body no term pushed (Q = +0), explicit, that Coriolis cannot turn (at rest, or no
-      // rotation) gets no load: the paths below give +0 to the bit (rhs = +0 whatever the sign
-      // of a zero velocity), here without their divisions (the rotation rate's too, when the
-      // body is at rest). Most floes of the towing case.
-      const bool unpushed = !implicit && plus_zero(q[0]) && plus_zero(q[1]) && plus_zero(q[2]);
-      if (unpushed && state.velocity[i].x == 0.0 && state.velocity[i].y == 0.0) {
-        loads_.force[i] = {};
-        loads_.torque[i] = 0.0;
-        continue;
-      }
-      const double f = sums_.any_rotation ? sums_.rotation_rate[i] * h.mass / mi : 0.0;
-      if (unpushed && f == 0.0) {
-        loads_.force[i] = {};
-        loads_.torque[i] = 0.0;
-        continue;
-      }
-      if (!implicit && f == 0.0) {
-        dv = {dt_ * q[0] / mi, dt_ * q[1] / mi, dt_ * q[2] / ii};
-      } else {
-        // f~ = (2 / dt) tan(angle / 2), so that the Cayley turn is exactly the angle; tan is
-        // cached per body (the rate rarely changes).
-        if (f != cached_rate_[i]) {
-          cached_rate_[i] = f;
-          cached_tan_[i] = std::tan(0.5 * f * dt_);
-          cached_half_tan_[i] = std::tan(0.25 * f * dt_);
-        }
-        const double ft = (2.0 / dt_) * (first_step ? cached_half_tan_[i] : cached_tan_[i]);
-        const double cv = mi * ft;  // C = cv [[0, -1], [1, 0]] on v
-        const Vec2 v = state.velocity[i];
-        const std::array<double, 3> rhs{q[0] + cv * v.y, q[1] - cv * v.x, q[2]};
-        if (!implicit) {
-          // [[M, -c], [c, M]] dv = rhs with M = m_I / dt, c = cv / 2: closed form.
-          const double m = mi / dt_, c = 0.5 * cv;
-          const double det = m * m + c * c;
-          dv = {(m * rhs[0] + c * rhs[1]) / det, (m * rhs[1] - c * rhs[0]) / det, dt_ * q[2] / ii};
-        } else {
-          std::array<double, 9> a = sums_.dq[i];
-          for (double& x : a) x = -x;
-          a[0] += mi / dt_;
-          a[4] += mi / dt_;
-          a[8] += ii / dt_;
-          a[1] += -0.5 * cv;
-          a[3] += 0.5 * cv;
-          dv = solve3(a, rhs);
-        }
-      }
-      loads_.force[i] = {h.engine_mass * dv[0] / dt_, h.engine_mass * dv[1] / dt_};
-      loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
-    }
-  });
+  if (sparse) {
+    thread_pool().for_blocks(moving.size(), 2048, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) load_body(static_cast<std::size_t>(moving[k]), state, first_step);
+    });
+  } else {
+    thread_pool().for_blocks(hot_.size(), 2048, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) load_body(i, state, first_step);
+    });
+  }
+  if (moving_only_) {
+    dirty_.assign(moving.begin(), moving.end());
+    have_dirty_ = true;
+  }
   return &loads_;
+}
+
+void Forcing::load_body(std::size_t i, const BodyStates& state, bool first_step) {
+  const BodyHot& h = hot_[i];
+  if (!h.moves) {
+    loads_.force[i] = {};
+    loads_.torque[i] = 0.0;
+    return;
+  }
+  const double mi = h.mass_with_added;
+  const double ii = h.inertia_with_added;
+  const std::array<double, 3>& q = sums_.q[i];
+  std::array<double, 3> dv;
+  const bool implicit = sums_.any_jacobian && stiff(sums_.dq[i], mi, ii);
+  // A body no term pushed (Q = +0), explicit, that Coriolis cannot turn (at rest, or no
+  // rotation) gets no load: the paths below give +0 to the bit (rhs = +0 whatever the sign
+  // of a zero velocity), here without their divisions (the rotation rate's too, when the
+  // body is at rest). Most floes of the towing case.
+  const bool unpushed = !implicit && plus_zero(q[0]) && plus_zero(q[1]) && plus_zero(q[2]);
+  if (unpushed && state.velocity[i].x == 0.0 && state.velocity[i].y == 0.0) {
+    loads_.force[i] = {};
+    loads_.torque[i] = 0.0;
+    return;
+  }
+  const double f = sums_.any_rotation ? sums_.rotation_rate[i] * h.mass / mi : 0.0;
+  if (unpushed && f == 0.0) {
+    loads_.force[i] = {};
+    loads_.torque[i] = 0.0;
+    return;
+  }
+  if (!implicit && f == 0.0) {
+    dv = {dt_ * q[0] / mi, dt_ * q[1] / mi, dt_ * q[2] / ii};
+  } else {
+    // f~ = (2 / dt) tan(angle / 2), so that the Cayley turn is exactly the angle; tan is
+    // cached per body (the rate rarely changes).
+    if (f != cached_rate_[i]) {
+      cached_rate_[i] = f;
+      cached_tan_[i] = std::tan(0.5 * f * dt_);
+      cached_half_tan_[i] = std::tan(0.25 * f * dt_);
+    }
+    const double ft = (2.0 / dt_) * (first_step ? cached_half_tan_[i] : cached_tan_[i]);
+    const double cv = mi * ft;  // C = cv [[0, -1], [1, 0]] on v
+    const Vec2 v = state.velocity[i];
+    const std::array<double, 3> rhs{q[0] + cv * v.y, q[1] - cv * v.x, q[2]};
+    if (!implicit) {
+      // [[M, -c], [c, M]] dv = rhs with M = m_I / dt, c = cv / 2: closed form.
+      const double m = mi / dt_, c = 0.5 * cv;
+      const double det = m * m + c * c;
+      dv = {(m * rhs[0] + c * rhs[1]) / det, (m * rhs[1] - c * rhs[0]) / det, dt_ * q[2] / ii};
+    } else {
+      std::array<double, 9> a = sums_.dq[i];
+      for (double& x : a) x = -x;
+      a[0] += mi / dt_;
+      a[4] += mi / dt_;
+      a[8] += ii / dt_;
+      a[1] += -0.5 * cv;
+      a[3] += 0.5 * cv;
+      dv = solve3(a, rhs);
+    }
+  }
+  loads_.force[i] = {h.engine_mass * dv[0] / dt_, h.engine_mass * dv[1] / dt_};
+  loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
 }
 
 }  // namespace floedem

@@ -4,11 +4,13 @@
 // Jacobian is Q with it, to the bit.
 #include <catch2/catch.hpp>
 
+#include <bit>
 #include <cmath>
 #include <random>
 
 #include "forcing/drag.hpp"
 #include "geometry/polygon.hpp"
+#include "support.hpp"
 
 using namespace floedem;
 
@@ -134,6 +136,57 @@ TEST_CASE("drag: in still water only the moving bodies are visited, with the sum
       CHECK(sums.q[i] == expected.q);
       CHECK(sums.dq[i] == expected.d);
       if (i == 0 || i == 3) CHECK(sums.q[i] == std::array<double, 3>{});
+    }
+  }
+}
+
+TEST_CASE("forcing: in still water with Coriolis the moving bodies alone give every body's loads to the bit",
+          "[forcing]") {
+  // After its first step a Forcing whose terms are all idle at rest (still-water drag,
+  // Coriolis) zeroes what its last step wrote and works on the moving bodies alone. Its loads
+  // must be those of a fresh Forcing, which works on every body, step after step, while
+  // floes start, stop (to +0 and to -0), spin in place and move again, and a towed body ramps.
+  std::string t = "[run]\nduration = 10.0\ndt = 0.5\n[environment]\nlatitude = 75.0\n";
+  for (int i = 0; i < 6; ++i) t += test::body_toml({"f" + std::to_string(i), test::box({40.0 * i, 0.0}, 10.0, 7.0), {}, 0.0});
+  t += "[[body]]\nname = \"berg\"\nkind = \"iceberg\"\npolygon = [[300, -20], [340, -20], [340, 20], [300, 20]]\n"
+       "draft = 30.0\nsail_height = 5.0\n[tow]\nmode = \"velocity\"\nbody = \"berg\"\npath = [[0.0, 0.0, 0.0], [4.0, 0.5, 0.1]]\n";
+  const Scene s = test::scene_from(t);
+  Forcing kept(s);
+  REQUIRE(kept.works_on_moving_bodies_only());
+  BodyStates st;
+  st.resize(s.bodies.size());
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) st.position[i] = s.bodies[i].centroid;
+  // Per step: each floe's velocity and spin.
+  const std::vector<std::vector<std::array<double, 3>>> steps{
+      {{0, 0, 0}, {0.3, 0, 0}, {0, 0, 0.01}, {0, 0, 0}, {-0.1, 0.2, 0}, {0, 0, 0}},
+      {{0, 0, 0}, {0.2, 0.1, 0.002}, {0, 0, 0}, {0.1, 0, 0}, {-0.1, 0.2, 0}, {0, 0, 0}},
+      {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {-0.0, -0.0, 0}, {0, 0, -0.003}, {0.4, -0.1, 0}},
+      {{0, 0, 0}, {0.05, 0, 0}, {0, 0, 0.02}, {0, 0, 0}, {0, 0, 0}, {0.4, -0.1, 0}},
+      {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}},
+      {{0, 0, 0}, {0.1, 0.1, 0.1}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}}};
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    INFO("step " << k);
+    for (std::size_t i = 0; i < 6; ++i) {
+      st.velocity[i] = {steps[k][i][0], steps[k][i][1]};
+      st.angular_velocity[i] = steps[k][i][2];
+      st.angle[i] += 0.01 * static_cast<double>(k * i);
+    }
+    const double time = 0.5 * static_cast<double>(k);
+    Forcing fresh(s);
+    const Loads* a = kept.evaluate(st, time);
+    const Loads* b = fresh.evaluate(st, time);
+    for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+      INFO("body " << i);
+      CHECK(std::bit_cast<std::uint64_t>(a->force[i].x) == std::bit_cast<std::uint64_t>(b->force[i].x));
+      CHECK(std::bit_cast<std::uint64_t>(a->force[i].y) == std::bit_cast<std::uint64_t>(b->force[i].y));
+      CHECK(std::bit_cast<std::uint64_t>(a->torque[i]) == std::bit_cast<std::uint64_t>(b->torque[i]));
+      if (s.bodies[i].prescribed) CHECK(kept.environment_force(i) == fresh.environment_force(i));
+    }
+    const bool any_moves = k != 4;
+    if (any_moves) {
+      bool loaded = false;
+      for (std::size_t i = 0; i < 6; ++i) loaded = loaded || a->force[i].x != 0.0 || a->torque[i] != 0.0;
+      CHECK(loaded);  // the case is not empty: drag acts on the moving floes
     }
   }
 }
