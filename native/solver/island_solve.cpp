@@ -50,14 +50,6 @@ constexpr int max_refinements = 12;
 
 }  // namespace
 
-std::int32_t IslandSolver::find(std::int32_t body) {
-  while (root_[body] != body) {
-    root_[body] = root_[root_[body]];
-    body = root_[body];
-  }
-  return body;
-}
-
 double IslandSolver::normal_velocity(const Manifold& m, const ManifoldPoint& q, const BodyArrays& s) {
   return dot(relative_velocity(s, m.body_a, m.body_b, q.ra, q.rb), m.normal);
 }
@@ -92,42 +84,29 @@ bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays&
   points_.clear();
   if (largest_shortfall(manifolds, s) <= trigger_velocity) return false;
 
-  // 2. Islands (union-find over moving bodies); the points of those holding such a point whose
-  // heaviest body is at least mass_ratio times its lightest.
-  const auto nb = static_cast<std::int32_t>(s.position.size());
-  root_.resize(static_cast<std::size_t>(nb));
-  std::iota(root_.begin(), root_.end(), 0);
-  for (const Manifold& m : manifolds)
-    if (s.inv_mass[m.body_a] > 0.0 && s.inv_mass[m.body_b] > 0.0) {
-      const std::int32_t ra = find(m.body_a), rb = find(m.body_b);
-      if (ra != rb) root_[std::max(ra, rb)] = std::min(ra, rb);
-    }
-  auto island = [&](const Manifold& m) { return find(s.inv_mass[m.body_a] > 0.0 ? m.body_a : m.body_b); };
-  // Per island root: the largest and smallest inverse mass of its bodies.
-  largest_inv_mass_.assign(static_cast<std::size_t>(nb), 0.0);
-  smallest_inv_mass_.assign(static_cast<std::size_t>(nb), std::numeric_limits<double>::infinity());
-  for (const Manifold& m : manifolds)
-    for (const std::int32_t body : {m.body_a, m.body_b})
-      if (s.inv_mass[body] > 0.0) {
-        const std::int32_t root = find(body);
-        largest_inv_mass_[root] = std::max(largest_inv_mass_[root], s.inv_mass[body]);
-        smallest_inv_mass_[root] = std::min(smallest_inv_mass_[root], s.inv_mass[body]);
-      }
-  in_island_.assign(static_cast<std::size_t>(nb), 0);
+  // 2. Islands (contact_islands.hpp); the points of those holding such a point whose heaviest
+  // body is at least mass_ratio times their lightest.
+  islands_.build(manifolds, s);
+  chosen_.assign(islands_.size(), 0);
   bool any = false;
-  for (const Manifold& m : manifolds)
-    for (int k = 0; k < m.point_count; ++k) {
-      const std::int32_t root = island(m);
-      if (shortfall(m, m.points[k], s) > trigger_velocity && largest_inv_mass_[root] >= mass_ratio * smallest_inv_mass_[root]) {
-        in_island_[root] = 1;
-        any = true;
-      }
+  for (std::size_t i = 0; i < islands_.size(); ++i) {
+    double largest_inv_mass = 0.0, smallest_inv_mass = std::numeric_limits<double>::infinity();
+    for (const std::int32_t body : islands_.bodies(i)) {
+      largest_inv_mass = std::max(largest_inv_mass, s.inv_mass[body]);
+      smallest_inv_mass = std::min(smallest_inv_mass, s.inv_mass[body]);
     }
+    if (!(largest_inv_mass >= mass_ratio * smallest_inv_mass)) continue;
+    for (const std::int32_t k : islands_.manifolds(i)) {
+      const Manifold& m = manifolds[static_cast<std::size_t>(k)];
+      for (int q = 0; q < m.point_count; ++q) chosen_[i] = chosen_[i] || shortfall(m, m.points[q], s) > trigger_velocity;
+    }
+    any = any || chosen_[i];
+  }
   if (!any) return false;
   manifolds_.clear();
   for (std::size_t mi = 0; mi < manifolds.size(); ++mi) {
     const Manifold& m = manifolds[mi];
-    if (!in_island_[island(m)]) continue;
+    if (!chosen_[static_cast<std::size_t>(islands_.island_of_manifold(mi))]) continue;
     manifolds_.push_back(static_cast<std::int32_t>(mi));
     for (int k = 0; k < m.point_count; ++k) points_.push_back({static_cast<std::int32_t>(mi), k, m.body_a, m.body_b});
   }

@@ -9,6 +9,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include "solver/contact_islands.hpp"
 #include "solver/contact_solver.hpp"
 
 namespace floedem {
@@ -40,7 +41,6 @@ class IslandSolver {
   }
   static double normal_velocity(const Manifold& m, const ManifoldPoint& q, const BodyArrays& bodies);
   static double shortfall(const Manifold& m, const ManifoldPoint& q, const BodyArrays& bodies);  ///< u* - u_n
-  std::int32_t find(std::int32_t body);
   void apply(std::span<const Manifold> manifolds, BodyArrays& bodies, std::size_t i, double pn, double pt) const;
   /// Velocities: the free ones plus every point's normal_ impulse.
   void apply_normals(std::span<const Manifold> manifolds, BodyArrays& bodies) const;
@@ -57,9 +57,8 @@ class IslandSolver {
   std::vector<double> free_velocity_;       // per point: u_n without the islands' impulses
   std::vector<std::int32_t> rows_;          // per row: its point
   std::vector<std::int32_t> wrong_;         // points whose answer breaks their conditions
-  std::vector<std::int32_t> root_;          // union-find over bodies
-  std::vector<std::uint8_t> in_island_;     // per island root: solved
-  std::vector<double> largest_inv_mass_, smallest_inv_mass_;  // per island root
+  ContactIslands islands_;                  // of the manifolds select() was given
+  std::vector<std::uint8_t> chosen_;        // per island: solved
   std::vector<std::int32_t> body_start_;    // per body + 1: where its rows begin in body_row_
   std::vector<std::int32_t> body_row_;      // rows grouped by body (each row under a and b)
   std::vector<std::int32_t> fill_;          // per body: fill cursor into body_row_
