@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "solver/headroom.hpp"
+
 namespace floedem {
 
 std::int32_t ContactIslands::find(std::int32_t body) {
@@ -54,6 +56,9 @@ void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays
   }
 
   // Grouped by island (counting sort, stable: each island's manifolds and bodies ascending).
+  reserve_with_headroom(manifold_start_, static_cast<std::size_t>(islands) + 1);
+  reserve_with_headroom(fill_, static_cast<std::size_t>(islands) + 1);
+  reserve_with_headroom(body_start_, static_cast<std::size_t>(islands) + 1);
   manifold_start_.assign(static_cast<std::size_t>(islands) + 1, 0);
   for (const std::int32_t i : manifold_island_) ++manifold_start_[i + 1];
   for (std::int32_t i = 0; i < islands; ++i) manifold_start_[i + 1] += manifold_start_[i];

@@ -8,6 +8,7 @@
 //   5. integrate  x += dt v+, angle += dt w+
 //   6. project    overlap beyond the allowed penetration removed on positions only
 //   7. record     contact impulses of the step, for the recorder
+#include "solver/headroom.hpp"
 #include "solver/native_engine.hpp"
 
 #include <algorithm>
@@ -550,6 +551,7 @@ void NativeEngine::build_manifolds() {
     }
   }
   std::swap(narrow_, previous_narrow_);
+  reserve_with_headroom(previous_pairs_, pairs_.size());
   previous_pairs_.assign(pairs_.begin(), pairs_.end());
   previous_reach_.assign(part_reach_.begin(), part_reach_.end());
   prepare_contacts(manifolds_, bodies_, dt_, contact_.collision_threshold);
