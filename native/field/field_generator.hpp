@@ -14,6 +14,8 @@
 //  4. each cell (convex, inside the domain, disjoint from the others) shrunk about its centroid
 //     to area A_i: the floe. It lies inside its own cell, so no two floes overlap, and the
 //     concentration is C to round-off.
+//  5. the floes numbered along a Hilbert curve through their centroids (neighbours near in
+//     number, so near in the engines' memory).
 #include <cstdint>
 #include <stdexcept>
 #include <string>
