@@ -87,13 +87,10 @@ class NativeEngine final : public Engine {
   std::vector<PartPair> pairs_;
   std::vector<Manifold> narrow_;          // per pair this step: the narrow phase's result
   // Narrow-phase reuse: collide() is a pure function of the two parts' placement and reaches,
-  // so a pair whose bodies sit exactly where they sat at the last step (position and rotation
-  // the same to the bit) with the same reaches gets the manifold computed last time, not a new
-  // one. In the towing case most pairs are of floes at rest.
-  std::vector<Vec2> placed_position_;      // per body: where its parts were last placed
-  std::vector<Rot> placed_rotation_;
-  std::vector<std::uint8_t> unmoved_;      // per body: placed where it was at the last step
-  bool any_unmoved_ = false;               // ... any body (else no reuse is looked for: a drifting field)
+  // so a pair of parts that PartSet::place kept where they were at the last step (their bodies'
+  // position and rotation the same to the bit) with the same reaches gets the manifold computed
+  // last time, not a new one. In the towing case most pairs are of floes at rest.
+  bool any_kept_ = false;                  // any part kept (else no reuse is looked for: a drifting field)
   std::vector<Manifold> previous_narrow_;  // the last narrow phase's results ...
   std::vector<PartPair> previous_pairs_;   // ... for these pairs ...
   std::vector<double> previous_reach_;     // ... with these part reaches
@@ -406,32 +403,12 @@ void NativeEngine::find_pairs(const Loads* loads) {
     linear_reach_[i] = dt_ * speed;
     angular_reach_[i] = dt_ * spin;
   }
-  bool unmoved = false;
-  for (std::size_t i = 0; i < nb; ++i) {
-    const Vec2 x = bodies_.position[i];
-    const Rot q = bodies_.rotation[i];
-    const Vec2 px = placed_position_[i];
-    const Rot pq = placed_rotation_[i];
-    const bool same = std::bit_cast<std::uint64_t>(x.x) == std::bit_cast<std::uint64_t>(px.x) &&
-                      std::bit_cast<std::uint64_t>(x.y) == std::bit_cast<std::uint64_t>(px.y) &&
-                      std::bit_cast<std::uint64_t>(q.c) == std::bit_cast<std::uint64_t>(pq.c) &&
-                      std::bit_cast<std::uint64_t>(q.s) == std::bit_cast<std::uint64_t>(pq.s);
-    unmoved_[i] = same ? 1 : 0;
-    unmoved = unmoved || same;
-    if (same) continue;
-    placed_position_[i] = x;
-    placed_rotation_[i] = q;
-  }
-  any_unmoved_ = unmoved;
-  parts_.place(bodies_.position, bodies_.rotation);
+  any_kept_ = parts_.place(bodies_.position, bodies_.rotation);
   pair_up();
 }
 
 void NativeEngine::forget_narrow() {
-  placed_position_.assign(bodies_.position.size(), Vec2{std::numeric_limits<double>::quiet_NaN(), 0.0});
-  placed_rotation_.assign(bodies_.position.size(), Rot{});
-  unmoved_.assign(bodies_.position.size(), 0);
-  any_unmoved_ = false;
+  any_kept_ = false;
   previous_pairs_.clear();
   previous_narrow_.clear();
   previous_reach_.clear();
@@ -479,7 +456,7 @@ void NativeEngine::build_manifolds() {
   // function of the pair: the same manifolds on any number of threads).
   narrow_.resize(pairs_.size());
   // Which pairs the last narrow phase computed with the same inputs (both lists sorted).
-  const bool may_reuse = any_unmoved_ && !previous_pairs_.empty();
+  const bool may_reuse = any_kept_ && !previous_pairs_.empty();
   if (may_reuse) {
     reuse_.resize(pairs_.size());
     auto same_reach = [&](std::int32_t part) {
@@ -489,7 +466,7 @@ void NativeEngine::build_manifolds() {
     for (std::size_t k = 0; k < pairs_.size(); ++k) {
       const PartPair pair = pairs_[k];
       reuse_[k] = -1;
-      if (!unmoved_[parts_.body()[pair.a]] || !unmoved_[parts_.body()[pair.b]]) continue;
+      if (!parts_.kept()[pair.a] || !parts_.kept()[pair.b]) continue;
       while (last < previous_pairs_.size() && previous_pairs_[last] < pair) ++last;
       if (last < previous_pairs_.size() && previous_pairs_[last] == pair && same_reach(pair.a) && same_reach(pair.b)) {
         reuse_[k] = static_cast<std::int32_t>(last);

@@ -1,6 +1,8 @@
 #include "solver/part_set.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <bit>
 #include <limits>
 
 #include "parallel/thread_pool.hpp"
@@ -34,18 +36,25 @@ PartSet::PartSet(const Scene& scene) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   placed_position_.assign(body_.size(), Vec2{nan, nan});
   placed_rotation_.assign(body_.size(), Rot{});
+  kept_.assign(body_.size(), 0);
 }
 
-void PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotation) {
+bool PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotation) {
+  // A body that has not moved since its parts were placed (a floe at rest) keeps them: the same
+  // pose gives the same vertices, so nothing is recomputed. Compared bit by bit: -0 and +0 are
+  // equal to ==, but a vertex at a centroid's coordinate could take either sign from them.
+  auto same = [](double x, double y) { return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y); };
+  std::atomic<bool> any_kept{false};
   // Parts are independent: blocks of them on the pool's threads.
   thread_pool().for_blocks(body_.size(), 2048, [&](std::size_t begin, std::size_t end) {
+    bool block_kept = false;
     for (std::size_t k = begin; k < end; ++k) {
       const std::int32_t b = body_[k];
-      // A body that has not moved since its parts were placed (a floe at rest) keeps them: the
-      // same pose gives the same vertices, so nothing is recomputed.
-      if (position[b].x == placed_position_[k].x && position[b].y == placed_position_[k].y &&
-          rotation[b].c == placed_rotation_[k].c && rotation[b].s == placed_rotation_[k].s)
-        continue;
+      const bool keep = same(position[b].x, placed_position_[k].x) && same(position[b].y, placed_position_[k].y) &&
+                        same(rotation[b].c, placed_rotation_[k].c) && same(rotation[b].s, placed_rotation_[k].s);
+      kept_[k] = keep ? 1 : 0;
+      block_kept = block_kept || keep;
+      if (keep) continue;
       placed_position_[k] = position[b];
       placed_rotation_[k] = rotation[b];
       const Transform x{position[b], rotation[b]};
@@ -62,7 +71,9 @@ void PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotatio
       }
       boxes_[k] = box;
     }
+    if (block_kept) any_kept.store(true, std::memory_order_relaxed);
   });
+  return any_kept.load(std::memory_order_relaxed);
 }
 
 PartGeometry PartSet::geometry(std::int32_t k, Vec2 position, Rot rotation) const {

@@ -16,8 +16,12 @@ class PartSet {
   explicit PartSet(const Scene& scene);
   std::size_t size() const { return body_.size(); }
 
-  /// World vertices, normals and tight bounds of every part for the bodies' placements.
-  void place(std::span<const Vec2> position, std::span<const Rot> rotation);
+  /// World vertices, normals and tight bounds of every part for the bodies' placements. A part
+  /// whose body's pose is, to the bit, the one of the last call keeps what it has (the same pose
+  /// gives the same vertices): kept() says which did. Returns whether any part kept its own.
+  bool place(std::span<const Vec2> position, std::span<const Rot> rotation);
+  /// Per part: 1 where the last place() kept the part's placement (its body did not move).
+  std::span<const std::uint8_t> kept() const { return kept_; }
 
   PartGeometry geometry(std::int32_t part, Vec2 position, Rot rotation) const;
   std::span<const std::int32_t> body() const { return body_; }
@@ -40,6 +44,7 @@ class PartSet {
   std::vector<Aabb> boxes_;
   std::vector<Vec2> placed_position_;  // per part: the pose it was last placed at (NaN: never)
   std::vector<Rot> placed_rotation_;
+  std::vector<std::uint8_t> kept_;
 };
 
 }  // namespace floedem
