@@ -8,7 +8,6 @@
 //   5. integrate  x += dt v+, angle += dt w+
 //   6. project    overlap beyond the allowed penetration removed on positions only
 //   7. record     contact impulses of the step, for the recorder
-#include "solver/headroom.hpp"
 #include "solver/native_engine.hpp"
 
 #include <algorithm>
@@ -21,6 +20,7 @@
 #include "solver/pair_cache.hpp"
 #include "solver/contact_islands.hpp"
 #include "solver/contact_solver.hpp"
+#include "solver/headroom.hpp"
 #include "solver/island_solve.hpp"
 #include "solver/narrow_phase.hpp"
 #include "solver/part_set.hpp"
