@@ -97,6 +97,9 @@ class DistributedDrag final : public ForceTerm {
   };
   void add_form_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const;
   void add_skin_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const;
+  /// The same without the Jacobian, for quadratic drag, two points at a time (drag.cpp).
+  void add_form_slab_lean(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot) const;
+  void add_skin_slab_lean(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot) const;
   /// Entry i's body moves with every slab's flow, without spin: it adds nothing (see drag.cpp).
   bool adds_nothing(std::size_t i, Vec2 v, double w) const;
   /// Entry i's force (and Jacobian where its body needs one); returns whether it added a Jacobian.
