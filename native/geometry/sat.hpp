@@ -48,4 +48,53 @@ inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView&
   return best;
 }
 
+/// Edge i's separation alone: the smallest signed distance of `b`'s vertices to edge i of `a`
+/// (the same value as the loops above give it: a minimum is exact in any order).
+inline double edge_separation(const ConvexView& a, const ConvexView& b, int i) {
+  const Vec2 n = a.normals[i];
+  const Vec2 v = a.vertices[i];
+  double s = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < b.count; ++j) {
+    const double d = dot(n, b.vertices[j] - v);
+    if (d < s) s = d;
+  }
+  return s;
+}
+
+/// max_face_separation, given edge `hint`'s separation `floor` (edge_separation): the same edge
+/// and separation to the bit, sooner when the hint is the winner or near it (a pair's best edge
+/// at its last step). The winner separates by at least `floor`, so an edge is left as soon as
+/// it falls below it; before the hint, an edge that ties it still wins (the first in order, as
+/// in the plain search), so only an edge below it is left there.
+inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView& b, double enough, int hint,
+                                          double floor) {
+  FaceSeparation best;
+  for (int i = 0; i < a.count; ++i) {
+    double s = floor;
+    if (i != hint) {
+      const double need = i < hint ? floor : -std::numeric_limits<double>::infinity();
+      const Vec2 n = a.normals[i];
+      const Vec2 v = a.vertices[i];
+      s = std::numeric_limits<double>::infinity();
+      for (int j = 0; j < b.count && s > best.separation && s >= need; ++j) {
+        const double d = dot(n, b.vertices[j] - v);
+        if (d < s) s = d;
+      }
+      if (s < need) continue;
+    }
+    if (s > best.separation) {
+      best.separation = s;
+      best.edge = i;
+      if (s > enough) break;
+    }
+  }
+  return best;
+}
+
+/// The edge of each polygon that separated most at a pair's last test (-1: none yet), where the
+/// next test of the pair starts (collide()).
+struct SeparationHint {
+  std::int16_t a = -1, b = -1;
+};
+
 }  // namespace floedem

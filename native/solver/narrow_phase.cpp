@@ -82,12 +82,32 @@ void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip,
 
 }  // namespace
 
-void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m) {
+void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m,
+             SeparationHint* hint) {
   m.point_count = 0;
-  const FaceSeparation sa = max_face_separation(a.world, b.world, margin);
-  if (sa.separation > margin) return;
-  const FaceSeparation sb = max_face_separation(b.world, a.world, margin);
-  if (sb.separation > margin) return;
+  FaceSeparation sa, sb;
+  if (hint) {
+    // The last test's best edges first (a pair's two floes turn little in a step). Whichever
+    // test says "apart" first, the answer is the same (no contact), and either polygon's
+    // largest separation is found as without the hint, to the bit (sat.hpp).
+    const bool hint_a = hint->a >= 0 && hint->a < a.world.count;
+    const bool hint_b = hint->b >= 0 && hint->b < b.world.count;
+    const double floor_b = hint_b ? edge_separation(b.world, a.world, hint->b) : 0.0;
+    if (hint_b && floor_b > margin) return;
+    sa = hint_a ? max_face_separation(a.world, b.world, margin, hint->a, edge_separation(a.world, b.world, hint->a))
+                : max_face_separation(a.world, b.world, margin);
+    hint->a = static_cast<std::int16_t>(sa.edge);
+    if (sa.separation > margin) return;
+    sb = hint_b ? max_face_separation(b.world, a.world, margin, hint->b, floor_b)
+                : max_face_separation(b.world, a.world, margin);
+    hint->b = static_cast<std::int16_t>(sb.edge);
+    if (sb.separation > margin) return;
+  } else {
+    sa = max_face_separation(a.world, b.world, margin);
+    if (sa.separation > margin) return;
+    sb = max_face_separation(b.world, a.world, margin);
+    if (sb.separation > margin) return;
+  }
 
   // Prefer a's face unless b's is clearly better: keeps the choice steady between steps.
   const bool flip = sb.separation > sa.separation + flip_tolerance;

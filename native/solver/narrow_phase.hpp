@@ -25,6 +25,9 @@ struct PartGeometry {
 /// Where clipping leaves nothing (the polygons apart, corner beside corner), the one point is the
 /// closest pair of points, its normal along the line joining them (what speculative contact
 /// needs: a floe sliding corner-first onto another's face within the step).
-void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m);
+/// `hint` (optional, kept per pair by the caller): the edges to test first, updated to this
+/// test's; the manifold is the same with or without it, to the bit.
+void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m,
+             SeparationHint* hint = nullptr);
 
 }  // namespace floedem

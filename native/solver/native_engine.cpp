@@ -53,7 +53,8 @@ class NativeEngine final : public Engine {
   PartGeometry part_geometry(std::int32_t k) const;
   double reach_of_part(std::int32_t k) const;
   Aabb reach_box(std::int32_t k, double reach) const;
-  void collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m) const;
+  void collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m,
+                     SeparationHint* hint = nullptr) const;
   void solve_contacts();
   struct IslandWork;
   int solve_island(std::size_t island, bool checked, IslandWork& work);
@@ -86,6 +87,9 @@ class NativeEngine final : public Engine {
   PairCache pair_cache_;
   std::vector<PartPair> pairs_;
   std::vector<Manifold> narrow_;          // per pair this step: the narrow phase's result
+  // Per pair, the edges that separated most at its last test, tried first (sat.hpp): the same
+  // manifolds, found sooner (a pair's floes turn little in a step).
+  std::vector<SeparationHint> narrow_hint_, previous_hint_;
   // Narrow-phase reuse: collide() is a pure function of the two parts' placement and reaches,
   // so a pair of parts that PartSet::place kept where they were at the last step (their bodies'
   // position and rotation the same to the bit) with the same reaches gets the manifold computed
@@ -437,11 +441,12 @@ Aabb NativeEngine::reach_box(std::int32_t k, double reach) const {
   return {parts_.boxes()[k].lo - Vec2{fat, fat}, parts_.boxes()[k].hi + Vec2{fat, fat}};
 }
 
-void NativeEngine::collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m) const {
+void NativeEngine::collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m,
+                                 SeparationHint* hint) const {
   // Contacts within both parts' reach this step (speculative), plus the allowed overlap; the
   // reference face kept unless the other is better by a tenth of it.
   collide(part_geometry(pair.a), part_geometry(pair.b), reach_a + reach_b + settings_.allowed_penetration,
-          0.1 * settings_.allowed_penetration, m);
+          0.1 * settings_.allowed_penetration, m, hint);
 }
 
 PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
@@ -455,23 +460,25 @@ void NativeEngine::build_manifolds() {
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
   narrow_.resize(pairs_.size());
-  // Which pairs the last narrow phase computed with the same inputs (both lists sorted).
+  // Per pair, its slot at the last narrow phase (both lists sorted): its separation hint
+  // carries over, and where both parts were kept in place with the same reaches, its manifold.
   const bool may_reuse = any_kept_ && !previous_pairs_.empty();
-  if (may_reuse) {
-    reuse_.resize(pairs_.size());
-    auto same_reach = [&](std::int32_t part) {
-      return std::bit_cast<std::uint64_t>(part_reach_[part]) == std::bit_cast<std::uint64_t>(previous_reach_[part]);
-    };
-    std::size_t last = 0;
-    for (std::size_t k = 0; k < pairs_.size(); ++k) {
-      const PartPair pair = pairs_[k];
-      reuse_[k] = -1;
-      if (!parts_.kept()[pair.a] || !parts_.kept()[pair.b]) continue;
-      while (last < previous_pairs_.size() && previous_pairs_[last] < pair) ++last;
-      if (last < previous_pairs_.size() && previous_pairs_[last] == pair && same_reach(pair.a) && same_reach(pair.b)) {
-        reuse_[k] = static_cast<std::int32_t>(last);
-        ++narrow_reused_;
-      }
+  if (may_reuse) reuse_.resize(pairs_.size());
+  narrow_hint_.resize(pairs_.size());
+  auto same_reach = [&](std::int32_t part) {
+    return std::bit_cast<std::uint64_t>(part_reach_[part]) == std::bit_cast<std::uint64_t>(previous_reach_[part]);
+  };
+  std::size_t last = 0;
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    const PartPair pair = pairs_[k];
+    while (last < previous_pairs_.size() && previous_pairs_[last] < pair) ++last;
+    const bool met = last < previous_pairs_.size() && previous_pairs_[last] == pair;
+    narrow_hint_[k] = met ? previous_hint_[last] : SeparationHint{};
+    if (!may_reuse) continue;
+    reuse_[k] = -1;
+    if (met && parts_.kept()[pair.a] && parts_.kept()[pair.b] && same_reach(pair.a) && same_reach(pair.b)) {
+      reuse_[k] = static_cast<std::int32_t>(last);
+      ++narrow_reused_;
     }
   }
   narrow_pairs_ += static_cast<std::int64_t>(pairs_.size());
@@ -497,7 +504,7 @@ void NativeEngine::build_manifolds() {
       m.body_b = parts_.body()[pair.b];
       m.friction = contact_.friction;
       m.restitution = contact_.restitution;
-      collide_parts(pair, part_reach_[pair.a], part_reach_[pair.b], m);
+      collide_parts(pair, part_reach_[pair.a], part_reach_[pair.b], m, &narrow_hint_[k]);
     }
   });
   std::size_t old = 0;  // both lists are sorted by (part_a, part_b): a merge carries impulses over
@@ -528,6 +535,7 @@ void NativeEngine::build_manifolds() {
     }
   }
   std::swap(narrow_, previous_narrow_);
+  std::swap(narrow_hint_, previous_hint_);
   reserve_with_headroom(previous_pairs_, pairs_.size());
   previous_pairs_.assign(pairs_.begin(), pairs_.end());
   previous_reach_.assign(part_reach_.begin(), part_reach_.end());

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <bit>
+#include <limits>
 #include <random>
 
 #include "engine/state_io.hpp"
@@ -188,6 +190,78 @@ TEST_CASE("narrow phase: the separating axes' shortcuts give the full search's e
   }
   CHECK(apart > 1000);
   CHECK(overlapping > 1000);
+}
+
+TEST_CASE("narrow phase: a pair's separation hint gives the manifold found without it to the bit", "[narrow]") {
+  // The engine starts each pair's separating-axis search at the edges that separated most at
+  // its last step (SeparationHint). Whatever the hint (none, right, wrong, one that ties the
+  // winner), max_face_separation must give the plain search's edge and separation to the bit,
+  // and collide() the same manifold. Pairs: random convex polygons (3 to 9 corners) near each
+  // other, and unturned squares on a diagonal, whose edges tie exactly.
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto polygon = [&](double size) {
+    const int corners = 3 + static_cast<int>(7.0 * u(rng));
+    std::vector<Vec2> p;
+    for (int k = 0; k < corners; ++k) {
+      const double a = 2.0 * M_PI * (k + 0.35 * u(rng)) / corners;
+      p.push_back({size * std::cos(a), size * std::sin(a)});
+    }
+    return p;
+  };
+  auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
+  auto same_vec = [&](Vec2 a, Vec2 b) { return bits(a.x) == bits(b.x) && bits(a.y) == bits(b.y); };
+  auto same_manifold = [&](const Manifold& a, const Manifold& b) {
+    if (a.point_count != b.point_count) return false;
+    if (a.point_count == 0) return true;
+    bool same = same_vec(a.normal, b.normal) && a.reference_is_b == b.reference_is_b &&
+                same_vec(a.local_normal, b.local_normal) && same_vec(a.local_face_point, b.local_face_point);
+    for (int k = 0; k < a.point_count; ++k)
+      same = same && same_vec(a.points[k].point, b.points[k].point) && a.points[k].id == b.points[k].id &&
+             bits(a.points[k].separation) == bits(b.points[k].separation) &&
+             same_vec(a.points[k].local_incident, b.points[k].local_incident);
+    return same;
+  };
+  int ties = 0, contacts = 0, hinted = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const bool diagonal = trial % 5 == 0;
+    const double size_a = 1.0 + 9.0 * u(rng), size_b = 1.0 + 9.0 * u(rng);
+    const double d = (size_a + size_b) * (0.3 + 0.9 * u(rng));
+    const double phi = 2.0 * M_PI * u(rng);
+    const Poly a = diagonal ? Poly(square(2.0), {0, 0}, 0.0) : Poly(polygon(size_a), {0, 0}, 2.0 * M_PI * u(rng));
+    const Poly b = diagonal ? Poly(square(2.0), {1.0 + 0.5 * (trial % 3), 1.0 + 0.5 * (trial % 3)}, 0.0)
+                            : Poly(polygon(size_b), {d * std::cos(phi), d * std::sin(phi)}, 2.0 * M_PI * u(rng));
+    const ConvexView va = a.view(), vb = b.view();
+    const double margin = 0.5 * u(rng);
+    for (const auto& [p, q] : {std::pair{va, vb}, std::pair{vb, va}}) {
+      const FaceSeparation plain = max_face_separation(p, q);
+      const FaceSeparation cut = max_face_separation(p, q, margin);
+      for (int i = 0; i < p.count; ++i) {
+        const double floor = edge_separation(p, q, i);
+        if (floor == plain.separation && i != plain.edge) ++ties;
+        const FaceSeparation h = max_face_separation(p, q, std::numeric_limits<double>::infinity(), i, floor);
+        REQUIRE(h.edge == plain.edge);
+        REQUIRE(bits(h.separation) == bits(plain.separation));
+        const FaceSeparation hc = max_face_separation(p, q, margin, i, floor);
+        REQUIRE((hc.separation > margin) == (cut.separation > margin));
+        if (cut.separation <= margin) REQUIRE((hc.edge == cut.edge && bits(hc.separation) == bits(cut.separation)));
+      }
+    }
+    Manifold plain;
+    collide(a.geometry(), b.geometry(), margin, 1e-4, plain);
+    contacts += plain.point_count > 0;
+    for (int ha = -1; ha < va.count; ++ha)
+      for (int hb = -1; hb < vb.count; ++hb) {
+        SeparationHint hint{static_cast<std::int16_t>(ha), static_cast<std::int16_t>(hb)};
+        Manifold m;
+        collide(a.geometry(), b.geometry(), margin, 1e-4, m, &hint);
+        REQUIRE(same_manifold(m, plain));
+        ++hinted;
+      }
+  }
+  CHECK(ties > 100);      // hints that tie the winner were tried
+  CHECK(contacts > 500);  // and pairs in contact, not only pairs apart
+  CHECK(hinted > 50000);
 }
 
 TEST_CASE("narrow phase: pairs of floes at rest reuse their manifolds to the bit of a fresh computation", "[narrow]") {
