@@ -205,8 +205,8 @@ void DistributedDrag::add_skin_slab(BodySum& sum, const Slab& slab, Vec2 v, doub
 namespace {
 // Two quadrature points side by side (GCC's vector extension: one SSE2 register on x86-64, two
 // scalars elsewhere). Each lane takes the scalar rule's operations in its order, and IEEE
-// arithmetic rounds each the same in a lane as alone (the x86-64 baseline has no fused
-// multiply-add to contract them into), so the lanes hold the rule's values to the bit.
+// arithmetic rounds each the same in a lane as alone (no fused multiply-add: the build says
+// -ffp-contract=off), so the lanes hold the rule's values to the bit.
 using Pair = double __attribute__((vector_size(16)));
 
 inline Pair sqrt_of(Pair x) {
