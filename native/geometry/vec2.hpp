@@ -1,8 +1,15 @@
 #pragma once
 // Plane vectors and rotations. The plane is (x, y), z points up, angles are counter-clockwise.
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 namespace floedem {
+
+/// Whether x and y are the same double to the bit: == takes -0 for +0 (a sign a later result
+/// can keep) and a NaN for nothing, so the shortcuts that keep a result when its inputs have
+/// not changed compare so.
+inline bool same_bits(double x, double y) { return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y); }
 
 struct Vec2 {
   double x = 0.0;

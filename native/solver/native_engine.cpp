@@ -466,7 +466,7 @@ void NativeEngine::build_manifolds() {
   if (may_reuse) reuse_.resize(pairs_.size());
   narrow_hint_.resize(pairs_.size());
   auto same_reach = [&](std::int32_t part) {
-    return std::bit_cast<std::uint64_t>(part_reach_[part]) == std::bit_cast<std::uint64_t>(previous_reach_[part]);
+    return same_bits(part_reach_[part], previous_reach_[part]);
   };
   std::size_t last = 0;
   for (std::size_t k = 0; k < pairs_.size(); ++k) {

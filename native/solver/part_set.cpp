@@ -43,15 +43,14 @@ bool PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotatio
   // A body that has not moved since its parts were placed (a floe at rest) keeps them: the same
   // pose gives the same vertices, so nothing is recomputed. Compared bit by bit: -0 and +0 are
   // equal to ==, but a vertex at a centroid's coordinate could take either sign from them.
-  auto same = [](double x, double y) { return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y); };
   std::atomic<bool> any_kept{false};
   // Parts are independent: blocks of them on the pool's threads.
   thread_pool().for_blocks(body_.size(), 2048, [&](std::size_t begin, std::size_t end) {
     bool block_kept = false;
     for (std::size_t k = begin; k < end; ++k) {
       const std::int32_t b = body_[k];
-      const bool keep = same(position[b].x, placed_position_[k].x) && same(position[b].y, placed_position_[k].y) &&
-                        same(rotation[b].c, placed_rotation_[k].c) && same(rotation[b].s, placed_rotation_[k].s);
+      const bool keep = same_bits(position[b].x, placed_position_[k].x) && same_bits(position[b].y, placed_position_[k].y) &&
+                        same_bits(rotation[b].c, placed_rotation_[k].c) && same_bits(rotation[b].s, placed_rotation_[k].s);
       kept_[k] = keep ? 1 : 0;
       block_kept = block_kept || keep;
       if (keep) continue;

@@ -2,8 +2,6 @@
 // (native_engine.cpp, solve_contacts).
 #include <catch2/catch.hpp>
 
-#include <cstring>
-
 #include "run/stepper.hpp"
 #include "solver/contact_islands.hpp"
 #include "support.hpp"
@@ -38,8 +36,6 @@ Scene scene(bool pressed_row) {
   }
   return test::scene_from(text);
 }
-
-bool same_bits(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
 
 }  // namespace
 
