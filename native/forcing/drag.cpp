@@ -216,6 +216,31 @@ inline Pair sqrt_of(Pair x) {
   return Pair{std::sqrt(x[0]), std::sqrt(x[1])};
 #endif
 }
+
+/// Two points of a body (body frame, scaled) turned into the world and the flow relative to
+/// them, as add_form_drag / add_skin_drag form r = rot p and u = flow - (v + w k x r).
+struct TwoPoints {
+  Pair rx, ry, ux, uy;
+};
+class PointKinematics {
+ public:
+  PointKinematics(Rot rot, Vec2 flow, Vec2 v, double w, bool rotational)
+      : c_{rot.c, rot.c}, s_{rot.s, rot.s}, fx_{flow.x, flow.x}, fy_{flow.y, flow.y}, vx_{v.x, v.x},
+        vy_{v.y, v.y}, neg_w_{-w, -w}, w_{w, w}, rotational_(rotational) {}
+  TwoPoints at(Vec2 p0, Vec2 p1) const {
+    const Pair lx = {p0.x, p1.x}, ly = {p0.y, p1.y};
+    TwoPoints t;
+    t.rx = c_ * lx - s_ * ly;  // rot.apply
+    t.ry = s_ * lx + c_ * ly;
+    t.ux = rotational_ ? fx_ - (vx_ + neg_w_ * t.ry) : fx_ - vx_;
+    t.uy = rotational_ ? fy_ - (vy_ + w_ * t.rx) : fy_ - vy_;
+    return t;
+  }
+
+ private:
+  Pair c_, s_, fx_, fy_, vx_, vy_, neg_w_, w_;
+  bool rotational_;
+};
 }  // namespace
 
 void DistributedDrag::add_form_slab_lean(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot) const {
@@ -223,25 +248,19 @@ void DistributedDrag::add_form_slab_lean(BodySum& sum, const Slab& slab, Vec2 v,
   // two lanes. A point the flow leaves (u.n >= 0) adds -0 in place of nothing: x + (-0) = x to
   // the bit for every x (a -0 sum included), so the sums are the rule's with no branch to
   // mispredict (half an outline's points face away from the flow).
-  const Pair c = {rot.c, rot.c}, s = {rot.s, rot.s};
-  const Pair fx = {slab.drag.flow.x, slab.drag.flow.x}, fy = {slab.drag.flow.y, slab.drag.flow.y};
-  const Pair vx = {v.x, v.x}, vy = {v.y, v.y};
-  const Pair neg_w = {-w, -w}, pos_w = {w, w};
+  const PointKinematics kinematics(rot, slab.drag.flow, v, w, settings_.rotational);
   const Pair none = {-0.0, -0.0};
   const bool rotational = settings_.rotational;
   double q0 = sum.q[0], q1 = sum.q[1], q2 = sum.q[2];
   const FormEdge* edge = form_.data() + slab.first;
   for (std::uint32_t j = 0; j < slab.count; ++j) {
     const Vec2 n = rot.apply(edge[j].normal);
-    const Pair lx = {edge[j].first.x, edge[j].second.x}, ly = {edge[j].first.y, edge[j].second.y};
-    const Pair rx = c * lx - s * ly, ry = s * lx + c * ly;              // rot.apply
-    const Pair ux = rotational ? fx - (vx + neg_w * ry) : fx - vx;      // flow - (v + w k x r)
-    const Pair uy = rotational ? fy - (vy + pos_w * rx) : fy - vy;
-    const Pair un = ux * n.x + uy * n.y;
-    const Pair kun = (-edge[j].weight) * un;                            // -k u.n
+    const TwoPoints p = kinematics.at(edge[j].first, edge[j].second);
+    const Pair un = p.ux * n.x + p.uy * n.y;
+    const Pair kun = (-edge[j].weight) * un;  // -k u.n
     const auto leaves = un >= 0.0;
-    const Pair f_x = leaves ? none : kun * ux, f_y = leaves ? none : kun * uy;
-    const Pair t = leaves ? none : rx * f_y - ry * f_x;                 // cross(r, f)
+    const Pair f_x = leaves ? none : kun * p.ux, f_y = leaves ? none : kun * p.uy;
+    const Pair t = leaves ? none : p.rx * f_y - p.ry * f_x;  // cross(r, f)
     q0 += f_x[0];
     q1 += f_y[0];
     if (rotational) q2 += t[0];
@@ -257,24 +276,8 @@ void DistributedDrag::add_skin_slab_lean(BodySum& sum, const Slab& slab, Vec2 v,
   // its middle point as the two lanes (their two square roots in one instruction); the
   // half-vertex it shares with the previous triangle comes from that triangle's first lane.
   if (slab.count == 0) return;
-  const Pair c = {rot.c, rot.c}, s = {rot.s, rot.s};
-  const Pair fx = {slab.drag.flow.x, slab.drag.flow.x}, fy = {slab.drag.flow.y, slab.drag.flow.y};
-  const Pair vx = {v.x, v.x}, vy = {v.y, v.y};
-  const Pair neg_w = {-w, -w}, pos_w = {w, w};
+  const PointKinematics kinematics(rot, slab.drag.flow, v, w, settings_.rotational);
   const bool rotational = settings_.rotational;
-  struct Lanes {
-    Pair rx, ry, ux, uy, m;  // r, u and |u| at two points
-  };
-  auto at = [&](Vec2 p0, Vec2 p1) {
-    const Pair lx = {p0.x, p1.x}, ly = {p0.y, p1.y};
-    Lanes l;
-    l.rx = c * lx - s * ly;
-    l.ry = s * lx + c * ly;
-    l.ux = rotational ? fx - (vx + neg_w * l.ry) : fx - vx;
-    l.uy = rotational ? fy - (vy + pos_w * l.rx) : fy - vy;
-    l.m = sqrt_of(l.ux * l.ux + l.uy * l.uy);
-    return l;
-  };
   double q0 = sum.q[0], q1 = sum.q[1], q2 = sum.q[2];
   // One point's k |u| u and its moment, added as add_skin_point adds them.
   auto add = [&](double rx, double ry, double ux, double uy, double m, double k) {
@@ -285,16 +288,18 @@ void DistributedDrag::add_skin_slab_lean(BodySum& sum, const Slab& slab, Vec2 v,
     if (rotational) q2 += rx * f_y - ry * f_x;
   };
   const SkinTriangle* t = skin_.data() + slab.first;
-  const Lanes first = at(t[0].half_vertex, t[0].half_vertex);
-  double ax = first.rx[0], ay = first.ry[0], aux = first.ux[0], auy = first.uy[0], am = first.m[0];
+  const TwoPoints first = kinematics.at(t[0].half_vertex, t[0].half_vertex);
+  double ax = first.rx[0], ay = first.ry[0], aux = first.ux[0], auy = first.uy[0];
+  double am = std::sqrt(aux * aux + auy * auy);  // length(u)
   for (std::uint32_t j = 0; j < slab.count; ++j) {
     const Vec2 next = j + 1 < slab.count ? t[j + 1].half_vertex : t[0].half_vertex;
-    const Lanes l = at(next, t[j].middle);  // lane 0: b, lane 1: the middle
+    const TwoPoints p = kinematics.at(next, t[j].middle);  // lane 0: b, lane 1: the middle
+    const Pair m = sqrt_of(p.ux * p.ux + p.uy * p.uy);      // |u|
     const double k = t[j].weight;
     add(ax, ay, aux, auy, am, k);
-    add(l.rx[0], l.ry[0], l.ux[0], l.uy[0], l.m[0], k);
-    add(l.rx[1], l.ry[1], l.ux[1], l.uy[1], l.m[1], k);
-    ax = l.rx[0], ay = l.ry[0], aux = l.ux[0], auy = l.uy[0], am = l.m[0];
+    add(p.rx[0], p.ry[0], p.ux[0], p.uy[0], m[0], k);
+    add(p.rx[1], p.ry[1], p.ux[1], p.uy[1], m[1], k);
+    ax = p.rx[0], ay = p.ry[0], aux = p.ux[0], auy = p.uy[0], am = m[0];
   }
   sum.q = {q0, q1, q2};
 }

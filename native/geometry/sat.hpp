@@ -23,33 +23,8 @@ struct FaceSeparation {
   double separation = -std::numeric_limits<double>::infinity();
 };
 
-/// Largest over the edges of `a` of the smallest signed distance of `b`'s vertices to that edge.
-/// Two exact shortcuts (the same edge and separation as the full double loop, to the bit): an
-/// edge is left at its first vertex no further than the best edge so far (its minimum cannot
-/// beat it), and the search ends at the first edge separating by more than `enough` (the caller
-/// needs to know no more: a pair beyond its contact margin).
-inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView& b,
-                                          double enough = std::numeric_limits<double>::infinity()) {
-  FaceSeparation best;
-  for (int i = 0; i < a.count; ++i) {
-    const Vec2 n = a.normals[i];
-    const Vec2 v = a.vertices[i];
-    double s = std::numeric_limits<double>::infinity();
-    for (int j = 0; j < b.count && s > best.separation; ++j) {
-      const double d = dot(n, b.vertices[j] - v);
-      if (d < s) s = d;
-    }
-    if (s > best.separation) {
-      best.separation = s;
-      best.edge = i;
-      if (s > enough) break;
-    }
-  }
-  return best;
-}
-
 /// Edge i's separation alone: the smallest signed distance of `b`'s vertices to edge i of `a`
-/// (the same value as the loops above give it: a minimum is exact in any order).
+/// (the same value as max_face_separation gives it: a minimum is exact in any order).
 inline double edge_separation(const ConvexView& a, const ConvexView& b, int i) {
   const Vec2 n = a.normals[i];
   const Vec2 v = a.vertices[i];
@@ -61,13 +36,20 @@ inline double edge_separation(const ConvexView& a, const ConvexView& b, int i) {
   return s;
 }
 
-/// max_face_separation, given edge `hint`'s separation `floor` (edge_separation): the same edge
-/// and separation to the bit, sooner when the hint is the winner or near it (a pair's best edge
-/// at its last step). The winner separates by at least `floor`, so an edge is left as soon as
-/// it falls below it; before the hint, an edge that ties it still wins (the first in order, as
-/// in the plain search), so only an edge below it is left there.
-inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView& b, double enough, int hint,
-                                          double floor) {
+/// Largest over the edges of `a` of the smallest signed distance of `b`'s vertices to that edge:
+/// the first edge in order that reaches it, and its separation. Three exact shortcuts (the same
+/// edge and separation as the full double loop, to the bit):
+///  - an edge is left at its first vertex no further than the best edge so far (its minimum
+///    cannot beat it);
+///  - the search ends at the first edge separating by more than `enough` (the caller needs to
+///    know no more: a pair beyond its contact margin);
+///  - given an edge `hint` and its separation `floor` (edge_separation; a pair's best edge at its
+///    last step), the winner separates by at least `floor`, so an edge is left as soon as it
+///    falls below it, and the hint is not searched again; before the hint, an edge that ties it
+///    still wins (the first in order), so only one below it is left there. hint < 0: none.
+inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView& b,
+                                          double enough = std::numeric_limits<double>::infinity(), int hint = -1,
+                                          double floor = 0.0) {
   FaceSeparation best;
   for (int i = 0; i < a.count; ++i) {
     double s = floor;

@@ -85,29 +85,22 @@ void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip,
 void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m,
              SeparationHint* hint) {
   m.point_count = 0;
-  FaceSeparation sa, sb;
-  if (hint) {
-    // The last test's best edges first (a pair's two floes turn little in a step). Whichever
-    // test says "apart" first, the answer is the same (no contact), and either polygon's
-    // largest separation is found as without the hint, to the bit (sat.hpp).
-    const bool hint_a = hint->a >= 0 && hint->a < a.world.count;
-    const bool hint_b = hint->b >= 0 && hint->b < b.world.count;
-    const double floor_b = hint_b ? edge_separation(b.world, a.world, hint->b) : 0.0;
-    if (hint_b && floor_b > margin) return;
-    sa = hint_a ? max_face_separation(a.world, b.world, margin, hint->a, edge_separation(a.world, b.world, hint->a))
-                : max_face_separation(a.world, b.world, margin);
-    hint->a = static_cast<std::int16_t>(sa.edge);
-    if (sa.separation > margin) return;
-    sb = hint_b ? max_face_separation(b.world, a.world, margin, hint->b, floor_b)
-                : max_face_separation(b.world, a.world, margin);
-    hint->b = static_cast<std::int16_t>(sb.edge);
-    if (sb.separation > margin) return;
-  } else {
-    sa = max_face_separation(a.world, b.world, margin);
-    if (sa.separation > margin) return;
-    sb = max_face_separation(b.world, a.world, margin);
-    if (sb.separation > margin) return;
-  }
+  // The last test's best edges first (a pair's two floes turn little in a step). Whichever
+  // test says "apart" first, the answer is the same (no contact), and either polygon's largest
+  // separation is found as without the hint, to the bit (sat.hpp). No hint: the plain search.
+  SeparationHint none;
+  SeparationHint& h = hint ? *hint : none;
+  const bool hint_a = h.a >= 0 && h.a < a.world.count;
+  const bool hint_b = h.b >= 0 && h.b < b.world.count;
+  const double floor_b = hint_b ? edge_separation(b.world, a.world, h.b) : 0.0;
+  if (hint_b && floor_b > margin) return;
+  const FaceSeparation sa = max_face_separation(a.world, b.world, margin, hint_a ? h.a : -1,
+                                                hint_a ? edge_separation(a.world, b.world, h.a) : 0.0);
+  h.a = static_cast<std::int16_t>(sa.edge);
+  if (sa.separation > margin) return;
+  const FaceSeparation sb = max_face_separation(b.world, a.world, margin, hint_b ? h.b : -1, floor_b);
+  h.b = static_cast<std::int16_t>(sb.edge);
+  if (sb.separation > margin) return;
 
   // Prefer a's face unless b's is clearly better: keeps the choice steady between steps.
   const bool flip = sb.separation > sa.separation + flip_tolerance;
