@@ -510,8 +510,11 @@ void NativeEngine::build_manifolds() {
   std::size_t old = 0;  // both lists are sorted by (part_a, part_b): a merge carries impulses over
   for (std::size_t slot = 0; slot < pairs_.size(); ++slot) {
     const PartPair pair = pairs_[slot];
-    if (narrow_[slot].point_count == 0) continue;
-    manifolds_.push_back(narrow_[slot]);  // narrow_ keeps the narrow phase's own result (reuse)
+    const Manifold& found = narrow_[slot];  // narrow_ keeps the narrow phase's own result (reuse)
+    if (found.point_count == 0) continue;
+    manifolds_.push_back(found);
+    // Read from the narrow phase's slot, not the fresh copy: a load from a block just copied
+    // waits for the copy's stores to retire (the 16k field: about 1 % of its step).
     Manifold& m = manifolds_.back();
     while (old < previous_manifolds_.size() &&
            PartPair{previous_manifolds_[old].part_a, previous_manifolds_[old].part_b} < pair)
@@ -519,10 +522,10 @@ void NativeEngine::build_manifolds() {
     if (old < previous_manifolds_.size() && previous_manifolds_[old].part_a == pair.a &&
         previous_manifolds_[old].part_b == pair.b) {
       const Manifold& prev = previous_manifolds_[old];
-      for (int k = 0; k < m.point_count; ++k) {
+      for (int k = 0; k < found.point_count; ++k) {
         for (int j = 0; j < prev.point_count; ++j) {
           const ManifoldPoint& was = prev.points[j];
-          if (was.id != m.points[k].id) continue;
+          if (was.id != found.points[k].id) continue;
           // Pressed last step: the bodies are already in contact here, so this is no collision.
           m.points[k].persistent = was.normal_impulse > 0.0;
           // Only resting impulses are a good first guess: a collision's impulse is a one-off.
