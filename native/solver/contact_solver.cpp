@@ -66,36 +66,35 @@ LocalImpulse solve_single_contact(double ufn, double uft, double target, double 
   return local_impulse(ufn, uft, target, mu, wnn, wnt, wtt);
 }
 
-void prepare_contacts(std::span<Manifold> manifolds, const BodyArrays& s, double dt, double collision_threshold) {
-  for (Manifold& m : manifolds) {
-    const int a = m.body_a, b = m.body_b;
-    const Vec2 n = m.normal;
-    const Vec2 t = perp(n);
-    const double ma = s.inv_mass[a], mb = s.inv_mass[b];
-    const double ia = s.inv_inertia[a], ib = s.inv_inertia[b];
-    for (int k = 0; k < m.point_count; ++k) {
-      ManifoldPoint& p = m.points[k];
-      p.ra = p.point - s.position[a];
-      p.rb = p.point - s.position[b];
-      const double rna = cross(p.ra, n), rnb = cross(p.rb, n);
-      const double rta = cross(p.ra, t), rtb = cross(p.rb, t);
-      p.wnn = ma + mb + ia * rna * rna + ib * rnb * rnb;
-      p.wtt = ma + mb + ia * rta * rta + ib * rtb * rtb;
-      p.wnt = ia * rna * rta + ib * rnb * rtb;
-      p.approach_velocity = dot(relative_velocity(s, a, b, p.ra, p.rb), n);
-      const double gap = std::max(p.separation, 0.0);
-      // A collision: a new contact, approaching faster than the threshold, reached within the
-      // step. A point that was pressed last step is resting whatever its approach speed: bodies
-      // already in contact do not collide, and their approach speed is solver residual (in a
-      // pressed pack, classifying it as a collision would make the pack bounce in place).
-      if (!p.persistent && p.approach_velocity < -collision_threshold && gap + dt * p.approach_velocity < 0.0) {
-        p.kind = ContactKind::collision;
-        // Newton's law; with e = 0 the bodies still close a speculative gap exactly.
-        p.target_velocity = std::max(-m.restitution * p.approach_velocity, -gap / dt);
-      } else {
-        p.kind = ContactKind::resting;
-        p.target_velocity = -gap / dt;
-      }
+void prepare_contact(Manifold& m, const BodyArrays& s, double dt, double collision_threshold) {
+  const int a = m.body_a, b = m.body_b;
+  const Vec2 n = m.normal;
+  const Vec2 t = perp(n);
+  const double ma = s.inv_mass[a], mb = s.inv_mass[b];
+  const double ia = s.inv_inertia[a], ib = s.inv_inertia[b];
+  for (int k = 0; k < m.point_count; ++k) {
+    ManifoldPoint& p = m.points[k];
+    p.ra = p.point - s.position[a];
+    p.rb = p.point - s.position[b];
+    const double rna = cross(p.ra, n), rnb = cross(p.rb, n);
+    const double rta = cross(p.ra, t), rtb = cross(p.rb, t);
+    p.wnn = ma + mb + ia * rna * rna + ib * rnb * rnb;
+    p.wtt = ma + mb + ia * rta * rta + ib * rtb * rtb;
+    p.wnt = ia * rna * rta + ib * rnb * rtb;
+    p.approach_velocity = dot(relative_velocity(s, a, b, p.ra, p.rb), n);
+    const double gap = std::max(p.separation, 0.0);
+    // A collision: a new contact, approaching faster than the threshold, reached within the
+    // step. A point that was pressed last step is resting whatever its approach speed: bodies
+    // already in contact do not collide, and their approach speed is solver residual (in a
+    // pressed pack, classifying it as a collision would make the pack bounce in place).
+    if (!p.persistent && p.approach_velocity < -collision_threshold && gap + dt * p.approach_velocity < 0.0) {
+      p.kind = ContactKind::collision;
+      // Newton's law; with e = 0 the bodies still close a speculative gap exactly.
+      p.target_velocity = std::max(-m.restitution * p.approach_velocity, -gap / dt);
+      p.normal_impulse = p.tangent_impulse = 0.0;
+    } else {
+      p.kind = ContactKind::resting;
+      p.target_velocity = -gap / dt;
     }
   }
 }

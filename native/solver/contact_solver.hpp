@@ -23,9 +23,10 @@ inline Vec2 relative_velocity(const BodyArrays& s, int a, int b, Vec2 ra, Vec2 r
   return (s.velocity[b] + cross(s.angular_velocity[b], rb)) - (s.velocity[a] + cross(s.angular_velocity[a], ra));
 }
 
-/// Classifies each point (collision or resting) from its approach velocity and gap, sets its
-/// target normal velocity, and fills the Delassus block.
-void prepare_contacts(std::span<Manifold> manifolds, const BodyArrays& bodies, double dt, double collision_threshold);
+/// Classifies each point of m (collision or resting) from its approach velocity and gap, sets
+/// its target normal velocity, and fills the Delassus block. A collision's impulses start from
+/// zero (Newton's law fixes them; a warm start's guess would be a resting impulse's).
+void prepare_contact(Manifold& m, const BodyArrays& bodies, double dt, double collision_threshold);
 
 /// Applies `impulse` (on b; its opposite on a) at point p of manifold m. A fixed or prescribed
 /// body (inv_mass = inv_inertia = 0) keeps its given velocity and is not written: the islands

@@ -1,7 +1,10 @@
 #pragma once
 // Contact data of the native solver: manifolds from the narrow phase, carried across steps
 // (accumulated impulses, for warm starting) by their feature ids.
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <type_traits>
 
 #include "engine/engine.hpp"
 #include "geometry/vec2.hpp"
@@ -37,5 +40,20 @@ struct Manifold {
   double friction = 0.0;
   double restitution = 0.0;
 };
+
+/// Copies what `from` holds into `to`: its pair, normal, its point_count points and its
+/// reference face; a point past point_count is left as it was (nothing reads it). A copy of
+/// the whole 384-byte struct compiles to a block move (rep movs), whose start-up, and the wait
+/// of any load from the copy for its stores, were ~2 % of the 16k field's step (perf).
+inline void copy_manifold(const Manifold& from, Manifold& to) {
+  static_assert(std::is_trivially_copyable_v<Manifold> && std::is_standard_layout_v<Manifold>);
+  std::memcpy(static_cast<void*>(&to), &from,
+              offsetof(Manifold, points) + static_cast<std::size_t>(from.point_count) * sizeof(ManifoldPoint));
+  to.reference_is_b = from.reference_is_b;
+  to.local_normal = from.local_normal;
+  to.local_face_point = from.local_face_point;
+  to.friction = from.friction;
+  to.restitution = from.restitution;
+}
 
 }  // namespace floedem

@@ -455,8 +455,10 @@ PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
 }
 
 void NativeEngine::build_manifolds() {
+  // The contact list is written over the one of two lists ago, slot by slot (copy_manifold
+  // writes what each contact holds, not the whole struct), and cut to length at the end.
   std::swap(manifolds_, previous_manifolds_);
-  manifolds_.clear();
+  std::size_t contacts = 0;
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
   narrow_.resize(pairs_.size());
@@ -490,7 +492,7 @@ void NativeEngine::build_manifolds() {
         if (was.point_count == 0)
           narrow_[k].point_count = 0;
         else
-          narrow_[k] = was;
+          copy_manifold(was, narrow_[k]);
         continue;
       }
       const PartPair pair = pairs_[k];
@@ -512,10 +514,11 @@ void NativeEngine::build_manifolds() {
     const PartPair pair = pairs_[slot];
     const Manifold& found = narrow_[slot];  // narrow_ keeps the narrow phase's own result (reuse)
     if (found.point_count == 0) continue;
-    manifolds_.push_back(found);
+    if (contacts == manifolds_.size()) manifolds_.emplace_back();
+    Manifold& m = manifolds_[contacts++];
+    copy_manifold(found, m);
     // Read from the narrow phase's slot, not the fresh copy: a load from a block just copied
-    // waits for the copy's stores to retire (the 16k field: about 1 % of its step).
-    Manifold& m = manifolds_.back();
+    // waits for the copy's stores to retire.
     while (old < previous_manifolds_.size() &&
            PartPair{previous_manifolds_[old].part_a, previous_manifolds_[old].part_b} < pair)
       ++old;
@@ -536,17 +539,15 @@ void NativeEngine::build_manifolds() {
         }
       }
     }
+    // Classified here, while the manifold is at hand (one pass over the contact list, not three).
+    prepare_contact(m, bodies_, dt_, contact_.collision_threshold);
   }
+  manifolds_.resize(contacts);
   std::swap(narrow_, previous_narrow_);
   std::swap(narrow_hint_, previous_hint_);
   reserve_with_headroom(previous_pairs_, pairs_.size());
   previous_pairs_.assign(pairs_.begin(), pairs_.end());
   previous_reach_.assign(part_reach_.begin(), part_reach_.end());
-  prepare_contacts(manifolds_, bodies_, dt_, contact_.collision_threshold);
-  // A point that is now a collision starts from zero: Newton's law fixes its impulse.
-  for (Manifold& m : manifolds_)
-    for (int k = 0; k < m.point_count; ++k)
-      if (m.points[k].kind == ContactKind::collision) m.points[k].normal_impulse = m.points[k].tangent_impulse = 0.0;
 }
 
 void NativeEngine::solve_contacts() {
