@@ -303,3 +303,72 @@ TEST_CASE("narrow phase: pairs of floes at rest reuse their manifolds to the bit
     CHECK(x.angular_velocity[i] == y.angular_velocity[i]);
   }
 }
+
+TEST_CASE("copy_manifold copies every field a contact holds and leaves an unused point as it was") {
+  // The contact list is built with copy_manifold (byte ranges, not the whole struct): a field
+  // it missed would reach the solver stale. Every field of the source set to a distinct value.
+  auto filled = [](double base) {
+    Manifold m;
+    m.part_a = 3;
+    m.part_b = 7;
+    m.body_a = 1;
+    m.body_b = 2;
+    m.normal = {base, base + 1};
+    for (ManifoldPoint& p : m.points) {
+      p.point = {base + 2, base + 3};
+      p.separation = base + 4;
+      p.id = static_cast<std::uint32_t>(base) + 5;
+      p.local_incident = {base + 6, base + 7};
+      p.normal_impulse = base + 8;
+      p.tangent_impulse = base + 9;
+      p.approach_velocity = base + 10;
+      p.target_velocity = base + 11;
+      p.kind = ContactKind::collision;
+      p.persistent = true;
+      p.ra = {base + 12, base + 13};
+      p.rb = {base + 14, base + 15};
+      p.wnn = base + 16;
+      p.wnt = base + 17;
+      p.wtt = base + 18;
+      base += 100;
+    }
+    m.reference_is_b = true;
+    m.local_normal = {base + 19, base + 20};
+    m.local_face_point = {base + 21, base + 22};
+    m.friction = base + 23;
+    m.restitution = base + 24;
+    return m;
+  };
+  auto same_vec = [](Vec2 a, Vec2 b) { return same_bits(a.x, b.x) && same_bits(a.y, b.y); };
+  auto same_point = [&](const ManifoldPoint& a, const ManifoldPoint& b) {
+    return same_vec(a.point, b.point) && same_bits(a.separation, b.separation) && a.id == b.id &&
+           same_vec(a.local_incident, b.local_incident) && same_bits(a.normal_impulse, b.normal_impulse) &&
+           same_bits(a.tangent_impulse, b.tangent_impulse) && same_bits(a.approach_velocity, b.approach_velocity) &&
+           same_bits(a.target_velocity, b.target_velocity) && a.kind == b.kind && a.persistent == b.persistent &&
+           same_vec(a.ra, b.ra) && same_vec(a.rb, b.rb) && same_bits(a.wnn, b.wnn) && same_bits(a.wnt, b.wnt) &&
+           same_bits(a.wtt, b.wtt);
+  };
+  for (const int count : {1, 2}) {
+    Manifold from = filled(1000.0);
+    from.point_count = count;
+    Manifold to = filled(5000.0);
+    const ManifoldPoint untouched = to.points[1];
+    copy_manifold(from, to);
+    CHECK(to.part_a == from.part_a);
+    CHECK(to.part_b == from.part_b);
+    CHECK(to.body_a == from.body_a);
+    CHECK(to.body_b == from.body_b);
+    CHECK(same_bits(to.normal.x, from.normal.x));
+    CHECK(same_bits(to.normal.y, from.normal.y));
+    CHECK(to.point_count == count);
+    CHECK(same_point(to.points[0], from.points[0]));
+    CHECK(same_point(to.points[1], count == 2 ? from.points[1] : untouched));
+    CHECK(to.reference_is_b == from.reference_is_b);
+    CHECK(same_bits(to.local_normal.x, from.local_normal.x));
+    CHECK(same_bits(to.local_normal.y, from.local_normal.y));
+    CHECK(same_bits(to.local_face_point.x, from.local_face_point.x));
+    CHECK(same_bits(to.local_face_point.y, from.local_face_point.y));
+    CHECK(same_bits(to.friction, from.friction));
+    CHECK(same_bits(to.restitution, from.restitution));
+  }
+}
