@@ -306,13 +306,15 @@ TEST_CASE("narrow phase: pairs of floes at rest reuse their manifolds to the bit
 
 TEST_CASE("copy_manifold copies every field a contact holds and leaves an unused point as it was") {
   // The contact list is built with copy_manifold (byte ranges, not the whole struct): a field
-  // it missed would reach the solver stale. Every field of the source set to a distinct value.
-  auto filled = [](double base) {
+  // it missed would reach the solver stale. Every field of the source and of the target set to
+  // values that differ between the two (flags included), so a field not copied fails its check.
+  auto filled = [](double base, bool flag) {
+    const auto id = static_cast<std::int32_t>(base);
     Manifold m;
-    m.part_a = 3;
-    m.part_b = 7;
-    m.body_a = 1;
-    m.body_b = 2;
+    m.part_a = id + 1;
+    m.part_b = id + 2;
+    m.body_a = id + 3;
+    m.body_b = id + 4;
     m.normal = {base, base + 1};
     for (ManifoldPoint& p : m.points) {
       p.point = {base + 2, base + 3};
@@ -323,8 +325,8 @@ TEST_CASE("copy_manifold copies every field a contact holds and leaves an unused
       p.tangent_impulse = base + 9;
       p.approach_velocity = base + 10;
       p.target_velocity = base + 11;
-      p.kind = ContactKind::collision;
-      p.persistent = true;
+      p.kind = flag ? ContactKind::collision : ContactKind::resting;
+      p.persistent = flag;
       p.ra = {base + 12, base + 13};
       p.rb = {base + 14, base + 15};
       p.wnn = base + 16;
@@ -332,7 +334,7 @@ TEST_CASE("copy_manifold copies every field a contact holds and leaves an unused
       p.wtt = base + 18;
       base += 100;
     }
-    m.reference_is_b = true;
+    m.reference_is_b = flag;
     m.local_normal = {base + 19, base + 20};
     m.local_face_point = {base + 21, base + 22};
     m.friction = base + 23;
@@ -349,9 +351,9 @@ TEST_CASE("copy_manifold copies every field a contact holds and leaves an unused
            same_bits(a.wtt, b.wtt);
   };
   for (const int count : {1, 2}) {
-    Manifold from = filled(1000.0);
+    Manifold from = filled(1000.0, true);
     from.point_count = count;
-    Manifold to = filled(5000.0);
+    Manifold to = filled(5000.0, false);
     const ManifoldPoint untouched = to.points[1];
     copy_manifold(from, to);
     CHECK(to.part_a == from.part_a);
