@@ -10,8 +10,12 @@
 #include "forcing/drag.hpp"
 #include "forcing/force_term.hpp"
 #include "geometry/polygon.hpp"
+#include "run/stepper.hpp"
 #include "scenario/scenario.hpp"
 #include "solver/broad_phase.hpp"
+#include "solver/contact_solver.hpp"
+#include "solver/narrow_phase.hpp"
+#include "solver/part_set.hpp"
 
 using namespace floedem;
 
@@ -173,6 +177,114 @@ void BM_FieldGenerator(benchmark::State& state) {
   state.counters["floes"] = static_cast<double>(floes);
 }
 BENCHMARK(BM_FieldGenerator)->Arg(10000)->Arg(100000)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+/// A packed field's contacts, for the two loops that take 40 % of its step (the contact sweeps
+/// and the narrow phase): the speed benchmark's 1 000 floes (scenarios/bench/field_wall_1k.toml)
+/// run 100 s onto their wall, the state the speed figures are timed in. Its pairs are found
+/// (broad phase over boxes grown by the margin) and collided as the native engine does, with a
+/// margin of the step's reach at the drift speed (0.5 m/s x 0.05 s per floe) plus the allowed
+/// overlap; its contacts are classified, and solved once from zero for a warm start. Made once.
+struct PackedField {
+  Scene scene;
+  PartSet parts;
+  BodyArrays bodies;
+  std::vector<PartPair> pairs;
+  std::vector<Manifold> manifolds;
+  static constexpr double kMargin = 2.0 * 0.5 * 0.05 + 1e-3;
+  static constexpr double kDt = 0.05;
+
+  PartGeometry geometry(std::int32_t part) const {
+    const std::int32_t b = parts.body()[part];
+    return parts.geometry(part, bodies.position[b], bodies.rotation[b]);
+  }
+
+  PackedField()
+      : scene(load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml")), parts(scene) {
+    Stepper stepper(scene, "native");
+    for (int step = 0; step < 2000; ++step) stepper.step();
+    const BodyStates& state = stepper.state();
+    const std::size_t n = state.position.size();
+    static_cast<BodyStates&>(bodies) = state;
+    for (std::size_t i = 0; i < n; ++i) {
+      bodies.rotation.push_back(Rot::from_angle(state.angle[i]));
+      bodies.inv_mass.push_back(scene.engine_inverse_mass(i));
+      bodies.inv_inertia.push_back(scene.engine_inverse_inertia(i));
+    }
+    parts.place(bodies.position, bodies.rotation);
+    std::vector<Aabb> boxes;
+    for (const Aabb& b : parts.boxes()) boxes.push_back({b.lo - 0.5 * Vec2{kMargin, kMargin}, b.hi + 0.5 * Vec2{kMargin, kMargin}});
+    BroadPhase().find_pairs(boxes, parts.body(), parts.immovable(), pairs);
+    for (const PartPair pair : pairs) {
+      Manifold m;
+      collide(geometry(pair.a), geometry(pair.b), kMargin, 1e-4, m);
+      if (m.point_count == 0) continue;
+      m.part_a = pair.a;
+      m.part_b = pair.b;
+      m.body_a = parts.body()[pair.a];
+      m.body_b = parts.body()[pair.b];
+      m.friction = scene.contact.friction;
+      m.restitution = scene.contact.restitution;
+      prepare_contact(m, bodies, kDt, scene.contact.collision_threshold);
+      manifolds.push_back(m);
+    }
+    BodyArrays scratch = bodies;
+    solve_velocities(manifolds, scratch, {10, 1e-10});
+  }
+};
+
+const PackedField& packed_field() {
+  static const PackedField field;
+  return field;
+}
+
+/// The contact sweeps of one step on the packed field: the warm start and 10 plain
+/// Gauss-Seidel sweeps (the speed benchmark's settings), from the same impulses and
+/// velocities each time. ns_per_point_sweep: the cost of one point's local solve.
+void BM_ContactSweeps(benchmark::State& state) {
+  const PackedField& field = packed_field();
+  std::vector<Manifold> manifolds = field.manifolds;
+  BodyArrays bodies = field.bodies;
+  std::size_t points = 0;
+  for (const Manifold& m : manifolds) points += static_cast<std::size_t>(m.point_count);
+  int sweeps = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    manifolds = field.manifolds;
+    bodies.velocity = field.bodies.velocity;
+    bodies.angular_velocity = field.bodies.angular_velocity;
+    state.ResumeTiming();
+    warm_start(manifolds, bodies);
+    sweeps = solve_velocities(manifolds, bodies, {10, 1e-10});
+    benchmark::DoNotOptimize(bodies.velocity.data());
+  }
+  state.counters["manifolds"] = static_cast<double>(manifolds.size());
+  state.counters["points"] = static_cast<double>(points);
+  state.counters["sweeps"] = sweeps;
+  state.counters["ns_per_point_sweep"] = benchmark::Counter(static_cast<double>(points) * sweeps,
+                                                            benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_ContactSweeps)->Unit(benchmark::kMicrosecond);
+
+/// The narrow phase of one step on the packed field: every pair of the broad phase collided
+/// (no reuse of last step's manifolds, no separation hints). ns_per_pair: one pair's test.
+void BM_NarrowPhase(benchmark::State& state) {
+  const PackedField& field = packed_field();
+  Manifold m;
+  std::size_t contacts = 0;
+  for (auto _ : state) {
+    contacts = 0;
+    for (const PartPair pair : field.pairs) {
+      collide(field.geometry(pair.a), field.geometry(pair.b), PackedField::kMargin, 1e-4, m);
+      contacts += m.point_count > 0;
+    }
+    benchmark::DoNotOptimize(contacts);
+  }
+  state.counters["pairs"] = static_cast<double>(field.pairs.size());
+  state.counters["contacts"] = static_cast<double>(contacts);
+  state.counters["ns_per_pair"] = benchmark::Counter(static_cast<double>(field.pairs.size()),
+                                                     benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_NarrowPhase)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
