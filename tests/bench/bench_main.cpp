@@ -15,6 +15,7 @@
 #include "solver/broad_phase.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/narrow_phase.hpp"
+#include "solver/native_settings.hpp"
 #include "solver/part_set.hpp"
 
 using namespace floedem;
@@ -182,41 +183,51 @@ BENCHMARK(BM_FieldGenerator)->Arg(10000)->Arg(100000)->Iterations(1)->Unit(bench
 /// and the narrow phase): the speed benchmark's 1 000 floes (scenarios/bench/field_wall_1k.toml)
 /// run 100 s onto their wall, the state the speed figures are timed in. Its pairs are found
 /// (broad phase over boxes grown by the margin) and collided as the native engine does, with a
-/// margin of the step's reach at the drift speed (0.5 m/s x 0.05 s per floe) plus the allowed
-/// overlap; its contacts are classified, and solved once from zero for a warm start. Made once.
+/// margin of two floes' reach at the drift speed (0.5 m/s over a step) plus the allowed overlap,
+/// and the engine's flip tolerance; its contacts are classified, and solved once from zero for a
+/// warm start. The step, sweep limits and overlap are the scenario's. Made once.
 struct PackedField {
   Scene scene;
+  NativeSettings settings;
+  SweepLimits limits;
+  double margin;
   PartSet parts;
   BodyArrays bodies;
   std::vector<PartPair> pairs;
   std::vector<Manifold> manifolds;
-  static constexpr double kMargin = 2.0 * 0.5 * 0.05 + 1e-3;
-  static constexpr double kDt = 0.05;
 
   PartGeometry geometry(std::int32_t part) const {
     const std::int32_t b = parts.body()[part];
     return parts.geometry(part, bodies.position[b], bodies.rotation[b]);
   }
+  void collide_pair(PartPair pair, Manifold& m) const {
+    collide(geometry(pair.a), geometry(pair.b), margin, 0.1 * settings.allowed_penetration, m);
+  }
 
   PackedField()
-      : scene(load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml")), parts(scene) {
+      : scene(load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml",
+                            {"run.duration=100.0"})),
+        settings(read_native_settings(scene)),
+        limits{settings.velocity_iterations, settings.tolerance},
+        margin(2.0 * 0.5 * scene.run.dt + settings.allowed_penetration),
+        parts(scene) {
     Stepper stepper(scene, "native");
-    for (int step = 0; step < 2000; ++step) stepper.step();
+    for (std::int64_t step = 0; step < scene.run.steps(); ++step) stepper.step();
     const BodyStates& state = stepper.state();
-    const std::size_t n = state.position.size();
     static_cast<BodyStates&>(bodies) = state;
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < state.position.size(); ++i) {
       bodies.rotation.push_back(Rot::from_angle(state.angle[i]));
       bodies.inv_mass.push_back(scene.engine_inverse_mass(i));
       bodies.inv_inertia.push_back(scene.engine_inverse_inertia(i));
     }
     parts.place(bodies.position, bodies.rotation);
     std::vector<Aabb> boxes;
-    for (const Aabb& b : parts.boxes()) boxes.push_back({b.lo - 0.5 * Vec2{kMargin, kMargin}, b.hi + 0.5 * Vec2{kMargin, kMargin}});
+    const Vec2 grow{0.5 * margin, 0.5 * margin};
+    for (const Aabb& b : parts.boxes()) boxes.push_back({b.lo - grow, b.hi + grow});
     BroadPhase().find_pairs(boxes, parts.body(), parts.immovable(), pairs);
     for (const PartPair pair : pairs) {
       Manifold m;
-      collide(geometry(pair.a), geometry(pair.b), kMargin, 1e-4, m);
+      collide_pair(pair, m);
       if (m.point_count == 0) continue;
       m.part_a = pair.a;
       m.part_b = pair.b;
@@ -224,11 +235,11 @@ struct PackedField {
       m.body_b = parts.body()[pair.b];
       m.friction = scene.contact.friction;
       m.restitution = scene.contact.restitution;
-      prepare_contact(m, bodies, kDt, scene.contact.collision_threshold);
+      prepare_contact(m, bodies, scene.run.dt, scene.contact.collision_threshold);
       manifolds.push_back(m);
     }
     BodyArrays scratch = bodies;
-    solve_velocities(manifolds, scratch, {10, 1e-10});
+    solve_velocities(manifolds, scratch, limits);
   }
 };
 
@@ -254,7 +265,7 @@ void BM_ContactSweeps(benchmark::State& state) {
     bodies.angular_velocity = field.bodies.angular_velocity;
     state.ResumeTiming();
     warm_start(manifolds, bodies);
-    sweeps = solve_velocities(manifolds, bodies, {10, 1e-10});
+    sweeps = solve_velocities(manifolds, bodies, field.limits);
     benchmark::DoNotOptimize(bodies.velocity.data());
   }
   state.counters["manifolds"] = static_cast<double>(manifolds.size());
@@ -274,7 +285,7 @@ void BM_NarrowPhase(benchmark::State& state) {
   for (auto _ : state) {
     contacts = 0;
     for (const PartPair pair : field.pairs) {
-      collide(field.geometry(pair.a), field.geometry(pair.b), PackedField::kMargin, 1e-4, m);
+      field.collide_pair(pair, m);
       contacts += m.point_count > 0;
     }
     benchmark::DoNotOptimize(contacts);
