@@ -1,16 +1,27 @@
 #pragma once
-// A persistent pool of worker threads for the per-step loops (forcing, narrow phase, placing,
-// integration). Work is split into blocks fixed by the loop's size and grain alone, and every
-// index writes only its own outputs, so results do not depend on the thread count: a run with
-// FLOEDEM_THREADS=1 and one with 16 are identical to the bit (tests/run/test_determinism.cpp).
-// The calling thread takes blocks too; workers sleep on a condition variable between loops
-// (no spinning: the report runs several processes on few cores). Waking them costs tens of
-// microseconds, so each loop's grain is set for a block of some 50-150 us of work: a small
-// scene runs inline on the caller.
+// A persistent pool of worker threads for the per-step loops (forcing, broad and narrow phase,
+// placing, islands, integration). Work is split into blocks fixed by the loop's size and grain
+// alone, and every index writes only its own outputs, so results do not depend on the thread
+// count or on which thread takes which block: a run with FLOEDEM_THREADS=1 and one with 16 are
+// identical to the bit (tests/run/test_determinism.cpp).
+//
+// A step runs some fifteen loops of 0.05 to 2 ms each, with serial work between them, so what a
+// loop costs beyond its blocks decides whether a second thread helps at all. Here:
+//  - a worker joins a job only while it is open, and the caller closes it as soon as every
+//    block is claimed: a worker still waking when the caller has done all the blocks alone
+//    joins nothing and is not waited for. The caller waits only for the workers inside the
+//    job (whose blocks it needs); before, it waited for every worker to pass through every
+//    job, a wake-up round trip (tens of microseconds on a VM) on each loop of the step;
+//  - a worker that has finished a job watches for the next for a short while (kSpin in
+//    thread_pool.cpp) before it sleeps on a condition variable, so the next loop of the same
+//    step finds it awake; the caller watches the last blocks likewise before it sleeps. The
+//    bound is short enough that a pool on a shared machine gives its core back almost at once
+//    (the report runs one process per core, each with one thread and so no workers).
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -29,6 +40,7 @@ class ThreadPool {
 
   /// Calls fn(begin, end) for consecutive blocks of at most `grain` indices covering [0, n),
   /// spread over the threads; returns when all are done. Inline when one block covers it.
+  /// One loop at a time: fn must not call for_blocks.
   template <class F>
   void for_blocks(std::size_t n, std::size_t grain, F&& fn) {
     grain = std::max<std::size_t>(grain, 1);
@@ -54,16 +66,27 @@ class ThreadPool {
   void work_loop();
   void take_blocks();
 
+  // state_: the job's number (high half), how many workers are inside it (bits 1-31) and
+  // whether it is closed to more (bit 0). A worker enters an open job with a compare-exchange,
+  // and only then reads the job's fields; the caller closes the job once every block is
+  // claimed and writes the next job's fields only after the last worker inside has left.
+  static constexpr std::uint64_t kClosed = 1, kEntered = 2;
+  static std::uint32_t job_of(std::uint64_t s) { return static_cast<std::uint32_t>(s >> 32); }
+  static std::uint64_t inside(std::uint64_t s) { return (s & 0xffffffffu) >> 1; }
+
   std::vector<std::thread> workers_;
-  std::mutex mutex_;
-  std::condition_variable wake_, done_;
-  void* context_ = nullptr;
+  std::atomic<std::uint64_t> state_{0};
+  void* context_ = nullptr;  // the job (read by a worker only while it is inside)
   BlockFn block_ = nullptr;
   std::size_t blocks_ = 0;
-  std::atomic<std::size_t> next_{0};
-  std::size_t busy_ = 0;          // workers inside the current job (under mutex_)
-  std::uint64_t generation_ = 0;  // bumped for each job (under mutex_)
-  bool stop_ = false;
+  std::atomic<std::size_t> next_{0};  // next block to claim
+  std::uint32_t job_ = 0;             // jobs run so far (the caller's)
+  // Sleeping, after kSpin without news: workers on wake_, the caller on finished_.
+  std::mutex mutex_;
+  std::condition_variable wake_, finished_;
+  std::atomic<int> sleepers_{0};
+  std::atomic<bool> caller_asleep_{false};
+  std::atomic<bool> stop_{false};
 };
 
 /// The process's pool, with worker_threads() threads (FLOEDEM_THREADS), made on first use.
