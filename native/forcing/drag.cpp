@@ -323,7 +323,7 @@ void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& 
 }
 
 bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) const {
-  for_entries(sums, 4096, [&](std::size_t i) { add_entry_bound(i, s, sums); });
+  for_entries(sums, 2048, [&](std::size_t i) { add_entry_bound(i, s, sums); });
   return true;
 }
 

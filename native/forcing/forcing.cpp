@@ -165,16 +165,21 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
     at.angular_velocity = moved_angular_velocity_;
   }
 
+  // Per body (blocks on the pool's threads): its rotation where it turned; then, in body order,
+  // the list of the bodies that move.
+  thread_pool().for_blocks(hot_.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (at.angle[i] != rotated_angle_[i]) {  // the body turned (or the first step)
+        sums_.rotation[i] = Rot::from_angle(at.angle[i]);
+        rotated_angle_[i] = at.angle[i];
+      }
+  });
   sums_.stirred.clear();
-  for (std::size_t i = 0; i < hot_.size(); ++i) {
-    if (at.angle[i] != rotated_angle_[i]) {  // the body turned (or the first step)
-      sums_.rotation[i] = Rot::from_angle(at.angle[i]);
-      rotated_angle_[i] = at.angle[i];
+  if (list_stirred_)
+    for (std::size_t i = 0; i < hot_.size(); ++i) {
+      const Vec2 v = at.velocity[i];
+      if (v.x != 0.0 || v.y != 0.0 || at.angular_velocity[i] != 0.0) sums_.stirred.push_back(static_cast<std::int32_t>(i));
     }
-    const Vec2 v = at.velocity[i];
-    if (list_stirred_ && (v.x != 0.0 || v.y != 0.0 || at.angular_velocity[i] != 0.0))
-      sums_.stirred.push_back(static_cast<std::int32_t>(i));
-  }
   // Moving bodies alone (moving_only_): every term is idle at rest, so a body at rest gets
   // Q = +0, no Jacobian and no rate bound, hence no load (load_body's first skip), and its
   // entries stay as the full path would set them once those the last step wrote are zeroed.
@@ -207,9 +212,13 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time) {
     sums_.jacobian[i] = !bounded || (h.moves && dt_ * rate * (1.0 + 1e-6) > kExplicitLimit);
   };
   if (sparse) {
-    for (const std::int32_t i : moving) needs_jacobian(static_cast<std::size_t>(i));
+    thread_pool().for_blocks(moving.size(), 8192, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) needs_jacobian(static_cast<std::size_t>(moving[k]));
+    });
   } else {
-    for (std::size_t i = 0; i < hot_.size(); ++i) needs_jacobian(i);
+    thread_pool().for_blocks(hot_.size(), 8192, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) needs_jacobian(i);
+    });
     std::fill(sums_.q.begin(), sums_.q.end(), std::array<double, 3>{});
     if (sums_.any_jacobian) std::fill(sums_.dq.begin(), sums_.dq.end(), std::array<double, 9>{});
   }

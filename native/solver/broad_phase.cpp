@@ -3,11 +3,15 @@
 #include <algorithm>
 #include <cmath>
 
+#include "parallel/thread_pool.hpp"
+
 namespace floedem {
 
 namespace {
 constexpr int kBruteForceBelow = 24;  // fewer parts than this: the n^2/2 test is cheaper
 constexpr int kMaxLevels = 32;
+constexpr std::size_t kPartGrain = 4096;   // parts a block of the pairs across levels (0.2-0.5 ms)
+constexpr std::size_t kCellGrain = 32768;  // cells a block of the pairs within a level (0.1-0.3 ms)
 }  // namespace
 
 std::int64_t BroadPhase::Level::cell_x(double x, double x0) const {
@@ -118,41 +122,87 @@ void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::in
     return lv.cell_y(cy, world.lo.y) * lv.nx + lv.cell_x(cx, world.lo.x);
   };
 
-  // Pairs within a level.
-  for (int l = 0; l <= top; ++l) {
-    const Level& lv = levels_[l];
-    if (lv.count < 2) continue;
-    const std::int64_t cells = lv.nx * lv.ny;
-    for (std::int64_t c = 0; c < cells; ++c) {
-      const std::int32_t begin = lv.cell_start[c], end = lv.cell_start[c + 1];
-      for (std::int32_t s = begin; s < end; ++s) {
+  // Pairs, in two loops whose blocks run on the pool's threads, each block into its own list,
+  // sorted there; the sorted lists are then merged. The blocks are fixed by the grid and n
+  // alone, and the merged list is the sorted set of pairs: the same on any number of threads.
+  // Each pair is reported from one cell only (reporting_cell), so once.
+  //  1. within a level: the pairs of each cell's parts, over the cells of every level as one
+  //     run of indices (cell_base_: where each level's cells begin in it);
+  //  2. across levels: each part against the parts of the cells it covers on coarser levels.
+  cell_base_.assign(static_cast<std::size_t>(top) + 2, 0);
+  for (int l = 0; l <= top; ++l)
+    cell_base_[l + 1] = cell_base_[l] + (levels_[l].count < 2 ? 0 : levels_[l].nx * levels_[l].ny);
+  const auto all_cells = static_cast<std::size_t>(cell_base_[top + 1]);
+  const std::size_t cell_blocks = (all_cells + kCellGrain - 1) / kCellGrain;
+  const std::size_t part_blocks = (static_cast<std::size_t>(n) + kPartGrain - 1) / kPartGrain;
+  if (found_.size() < cell_blocks + part_blocks) found_.resize(cell_blocks + part_blocks);
+  thread_pool().for_blocks(all_cells, kCellGrain, [&](std::size_t begin, std::size_t end) {
+    std::vector<PartPair>& found = found_[begin / kCellGrain];
+    found.clear();
+    int l = 0;
+    for (auto g = static_cast<std::int64_t>(begin); g < static_cast<std::int64_t>(end); ++g) {
+      while (g >= cell_base_[l + 1]) ++l;
+      const Level& lv = levels_[l];
+      const std::int64_t c = g - cell_base_[l];
+      const std::int32_t first = lv.cell_start[c], last = lv.cell_start[c + 1];
+      for (std::int32_t s = first; s < last; ++s) {
         const std::int32_t i = lv.items[s];
-        for (std::int32_t t = s + 1; t < end; ++t) {
+        for (std::int32_t t = s + 1; t < last; ++t) {
           const std::int32_t j = lv.items[t];
-          if (consider(i, j) && reporting_cell(lv, i, j) == c) out.push_back({std::min(i, j), std::max(i, j)});
+          if (consider(i, j) && reporting_cell(lv, i, j) == c) found.push_back({std::min(i, j), std::max(i, j)});
         }
       }
     }
-  }
-  // Pairs across levels: each part against the coarser levels' cells it covers.
-  for (std::int32_t i = 0; i < n; ++i) {
-    for (int l = level_of_[i] + 1; l <= top; ++l) {
-      const Level& lv = levels_[l];
-      if (lv.count == 0) continue;
-      const std::int64_t x0 = lv.cell_x(boxes[i].lo.x, world.lo.x), x1 = lv.cell_x(boxes[i].hi.x, world.lo.x);
-      const std::int64_t y0 = lv.cell_y(boxes[i].lo.y, world.lo.y), y1 = lv.cell_y(boxes[i].hi.y, world.lo.y);
-      for (std::int64_t y = y0; y <= y1; ++y) {
-        for (std::int64_t x = x0; x <= x1; ++x) {
-          const std::int64_t c = y * lv.nx + x;
-          for (std::int32_t s = lv.cell_start[c]; s < lv.cell_start[c + 1]; ++s) {
-            const std::int32_t j = lv.items[s];
-            if (consider(i, j) && reporting_cell(lv, i, j) == c) out.push_back({std::min(i, j), std::max(i, j)});
+    std::sort(found.begin(), found.end());
+  });
+  thread_pool().for_blocks(static_cast<std::size_t>(n), kPartGrain, [&](std::size_t begin, std::size_t end) {
+    std::vector<PartPair>& found = found_[cell_blocks + begin / kPartGrain];
+    found.clear();
+    for (auto i = static_cast<std::int32_t>(begin); i < static_cast<std::int32_t>(end); ++i) {
+      for (int l = level_of_[i] + 1; l <= top; ++l) {
+        const Level& lv = levels_[l];
+        if (lv.count == 0) continue;
+        const std::int64_t x0 = lv.cell_x(boxes[i].lo.x, world.lo.x), x1 = lv.cell_x(boxes[i].hi.x, world.lo.x);
+        const std::int64_t y0 = lv.cell_y(boxes[i].lo.y, world.lo.y), y1 = lv.cell_y(boxes[i].hi.y, world.lo.y);
+        for (std::int64_t y = y0; y <= y1; ++y) {
+          for (std::int64_t x = x0; x <= x1; ++x) {
+            const std::int64_t c = y * lv.nx + x;
+            for (std::int32_t s = lv.cell_start[c]; s < lv.cell_start[c + 1]; ++s) {
+              const std::int32_t j = lv.items[s];
+              if (consider(i, j) && reporting_cell(lv, i, j) == c) found.push_back({std::min(i, j), std::max(i, j)});
+            }
           }
         }
       }
     }
+    std::sort(found.begin(), found.end());
+  });
+  merge_sorted(std::span<std::vector<PartPair>>(found_.data(), cell_blocks + part_blocks), out);
+}
+
+void BroadPhase::merge_sorted(std::span<std::vector<PartPair>> runs, std::vector<PartPair>& out) {
+  // Pairwise rounds (log2 of the runs' count passes over the pairs), between out and merged_.
+  out.clear();
+  if (runs.empty()) return;
+  run_end_.clear();
+  for (const std::vector<PartPair>& r : runs) {
+    out.insert(out.end(), r.begin(), r.end());
+    run_end_.push_back(out.size());
   }
-  std::sort(out.begin(), out.end());
+  while (run_end_.size() > 1) {
+    merged_.resize(out.size());
+    std::size_t start = 0, kept = 0;
+    for (std::size_t k = 0; k < run_end_.size(); k += 2) {
+      const std::size_t mid = run_end_[k], stop = k + 1 < run_end_.size() ? run_end_[k + 1] : mid;
+      std::merge(out.begin() + static_cast<std::ptrdiff_t>(start), out.begin() + static_cast<std::ptrdiff_t>(mid),
+                 out.begin() + static_cast<std::ptrdiff_t>(mid), out.begin() + static_cast<std::ptrdiff_t>(stop),
+                 merged_.begin() + static_cast<std::ptrdiff_t>(start));
+      run_end_[kept++] = stop;
+      start = stop;
+    }
+    run_end_.resize(kept);
+    out.swap(merged_);
+  }
 }
 
 void BroadPhase::query(const Aabb& box, std::vector<std::int32_t>& out) const {

@@ -8,7 +8,8 @@
 // a power-law size spread (and an iceberg far larger than any floe) that is O(N log(d_max /
 // d_median)), with no allocation once the buffers have grown. A pair is reported only from the
 // cell (of the coarser part's level) that holds the lower-left corner of the two boxes'
-// intersection, so each pair appears once; the list is sorted at the end (deterministic).
+// intersection, so each pair appears once. Blocks of parts find their pairs on the pool's
+// threads, each list sorted, then merged: the sorted list, whatever the number of threads.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -48,10 +49,17 @@ class BroadPhase {
     std::int64_t cell_x(double x, double x0) const;
     std::int64_t cell_y(double y, double y0) const;
   };
+  /// Merges sorted runs (each sorted, all disjoint) into `out`, sorted.
+  void merge_sorted(std::span<std::vector<PartPair>> runs, std::vector<PartPair>& out);
+
   std::vector<double> extents_;
   std::vector<std::uint8_t> level_of_;
   std::vector<Level> levels_;
   std::vector<std::int32_t> cursor_;
+  std::vector<std::vector<PartPair>> found_;  // per block of parts: its pairs
+  std::vector<PartPair> merged_;
+  std::vector<std::int64_t> cell_base_;  // per level: where its cells begin among all levels' cells
+  std::vector<std::size_t> run_end_;
   Vec2 world_lo_;      // the grid's origin at the last build
   int top_ = 0;        // the coarsest level used at the last build
   bool gridded_ = false;

@@ -99,6 +99,7 @@ class NativeEngine final : public Engine {
   std::vector<PartPair> previous_pairs_;   // ... for these pairs ...
   std::vector<double> previous_reach_;     // ... with these part reaches
   std::vector<std::int32_t> reuse_;        // per pair: its slot in previous_narrow_, or -1
+  std::vector<std::size_t> block_contacts_;  // per block of pairs: contacts before it
   std::int64_t narrow_pairs_ = 0, narrow_reused_ = 0;  // pairs tested over the run, and those reused (info)
   void forget_narrow();                    // no reuse at the next narrow phase
   std::vector<Manifold> manifolds_, previous_manifolds_;
@@ -125,6 +126,7 @@ class NativeEngine final : public Engine {
   };
   std::vector<IslandWork> island_work_;  // per block of islands
   static constexpr std::size_t kIslandGrain = 8;  // islands per block
+  static constexpr std::size_t kPairGrain = 512;  // pairs per block (narrow phase, contact list)
   std::vector<Vec2> saved_velocity_;
   std::vector<double> saved_angular_velocity_;
   std::vector<double> saved_impulses_;
@@ -396,17 +398,18 @@ void NativeEngine::find_pairs(const Loads* loads) {
   // Reach: how far any point of a body can travel this step (dt times its speed after the
   // loads, plus spin times the part's radius), so that contacts are found before the bodies
   // would overlap (speculative contact) and their bounds need no rebuild within the step.
-  const std::size_t nb = bodies_.position.size();
-  for (std::size_t i = 0; i < nb; ++i) {
-    double speed = length(bodies_.velocity[i]);
-    double spin = std::abs(bodies_.angular_velocity[i]);
-    if (loads) {
-      speed += dt_ * length(loads->force[i]) * bodies_.inv_mass[i];
-      spin += dt_ * std::abs(loads->torque[i]) * bodies_.inv_inertia[i];
+  thread_pool().for_blocks(bodies_.position.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      double speed = length(bodies_.velocity[i]);
+      double spin = std::abs(bodies_.angular_velocity[i]);
+      if (loads) {
+        speed += dt_ * length(loads->force[i]) * bodies_.inv_mass[i];
+        spin += dt_ * std::abs(loads->torque[i]) * bodies_.inv_inertia[i];
+      }
+      linear_reach_[i] = dt_ * speed;
+      angular_reach_[i] = dt_ * spin;
     }
-    linear_reach_[i] = dt_ * speed;
-    angular_reach_[i] = dt_ * spin;
-  }
+  });
   any_kept_ = parts_.place(bodies_.position, bodies_.rotation);
   pair_up();
 }
@@ -419,14 +422,15 @@ void NativeEngine::forget_narrow() {
 }
 
 void NativeEngine::pair_up() {
-  const std::size_t np = parts_.size();
-  for (std::size_t k = 0; k < np; ++k) {
-    part_reach_[k] = reach_of_part(static_cast<std::int32_t>(k));
-    part_boxes_[k] = reach_box(static_cast<std::int32_t>(k), part_reach_[k]);
-    // A part that leaves its fat box gets room for about four steps at its present reach and a
-    // tenth of its size besides (so that a floe at rest, or creeping, keeps its box for long).
-    part_margin_[k] = 4.0 * part_reach_[k] + 0.1 * parts_.radius(static_cast<std::int32_t>(k));
-  }
+  thread_pool().for_blocks(parts_.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      part_reach_[k] = reach_of_part(static_cast<std::int32_t>(k));
+      part_boxes_[k] = reach_box(static_cast<std::int32_t>(k), part_reach_[k]);
+      // A part that leaves its fat box gets room for about four steps at its present reach and
+      // a tenth of its size besides (so that a floe at rest, or creeping, keeps its box long).
+      part_margin_[k] = 4.0 * part_reach_[k] + 0.1 * parts_.radius(static_cast<std::int32_t>(k));
+    }
+  });
   pair_cache_.find_pairs(part_boxes_, part_margin_, parts_.body(), parts_.immovable(), pairs_);
 }
 
@@ -458,7 +462,6 @@ void NativeEngine::build_manifolds() {
   // The contact list is written over the one of two lists ago, slot by slot (copy_manifold
   // writes what each contact holds, not the whole struct), and cut to length at the end.
   std::swap(manifolds_, previous_manifolds_);
-  std::size_t contacts = 0;
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
   narrow_.resize(pairs_.size());
@@ -484,7 +487,9 @@ void NativeEngine::build_manifolds() {
     }
   }
   narrow_pairs_ += static_cast<std::int64_t>(pairs_.size());
-  thread_pool().for_blocks(pairs_.size(), 512, [&](std::size_t begin, std::size_t end) {
+  const std::size_t blocks = (pairs_.size() + kPairGrain - 1) / kPairGrain;
+  block_contacts_.assign(blocks + 1, 0);
+  thread_pool().for_blocks(pairs_.size(), kPairGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       if (may_reuse && reuse_[k] >= 0) {
         const Manifold& was = previous_narrow_[static_cast<std::size_t>(reuse_[k])];
@@ -508,40 +513,58 @@ void NativeEngine::build_manifolds() {
       m.restitution = contact_.restitution;
       collide_parts(pair, part_reach_[pair.a], part_reach_[pair.b], m, &narrow_hint_[k]);
     }
+    std::size_t found = 0;  // the block's contacts, for their places in the list
+    for (std::size_t k = begin; k < end; ++k) found += narrow_[k].point_count != 0;
+    block_contacts_[begin / kPairGrain + 1] = found;
   });
-  std::size_t old = 0;  // both lists are sorted by (part_a, part_b): a merge carries impulses over
-  for (std::size_t slot = 0; slot < pairs_.size(); ++slot) {
-    const PartPair pair = pairs_[slot];
-    const Manifold& found = narrow_[slot];  // narrow_ keeps the narrow phase's own result (reuse)
-    if (found.point_count == 0) continue;
-    if (contacts == manifolds_.size()) manifolds_.emplace_back();
-    Manifold& m = manifolds_[contacts++];
-    copy_manifold(found, m);
-    // Read from the narrow phase's slot, not the fresh copy: a load from a block just copied
-    // waits for the copy's stores to retire.
-    while (old < previous_manifolds_.size() &&
-           PartPair{previous_manifolds_[old].part_a, previous_manifolds_[old].part_b} < pair)
-      ++old;
-    if (old < previous_manifolds_.size() && previous_manifolds_[old].part_a == pair.a &&
-        previous_manifolds_[old].part_b == pair.b) {
-      const Manifold& prev = previous_manifolds_[old];
-      for (int k = 0; k < found.point_count; ++k) {
-        for (int j = 0; j < prev.point_count; ++j) {
-          const ManifoldPoint& was = prev.points[j];
-          if (was.id != found.points[k].id) continue;
-          // Pressed last step: the bodies are already in contact here, so this is no collision.
-          m.points[k].persistent = was.normal_impulse > 0.0;
-          // Only resting impulses are a good first guess: a collision's impulse is a one-off.
-          if (settings_.warm_start && was.kind == ContactKind::resting) {
-            m.points[k].normal_impulse = was.normal_impulse;
-            m.points[k].tangent_impulse = was.tangent_impulse;
+  // The contacts, in pair order, each into its slot of the list: per block of pairs (the
+  // narrow phase's blocks), its first slot is the count of contacts in the blocks before it.
+  // (each narrow-phase block counted its own).
+  for (std::size_t b = 0; b < blocks; ++b) block_contacts_[b + 1] += block_contacts_[b];
+  const std::size_t contacts = block_contacts_[blocks];
+  if (manifolds_.size() < contacts) manifolds_.resize(contacts);
+  // Blocks on the pool's threads again: each manifold is written from its own slot, its
+  // impulses carried over from last step's list (both lists are sorted by (part_a, part_b):
+  // a merge from where the block's first pair would be) and classified, a function of the
+  // manifold and the bodies alone: the same list on any number of threads.
+  thread_pool().for_blocks(pairs_.size(), kPairGrain, [&](std::size_t begin, std::size_t end) {
+    std::size_t slot = block_contacts_[begin / kPairGrain];
+    auto old = static_cast<std::size_t>(
+        std::lower_bound(previous_manifolds_.begin(), previous_manifolds_.end(), pairs_[begin],
+                         [](const Manifold& m, PartPair p) { return PartPair{m.part_a, m.part_b} < p; }) -
+        previous_manifolds_.begin());
+    for (std::size_t k = begin; k < end; ++k) {
+      const PartPair pair = pairs_[k];
+      const Manifold& found = narrow_[k];  // narrow_ keeps the narrow phase's own result (reuse)
+      if (found.point_count == 0) continue;
+      Manifold& m = manifolds_[slot++];
+      copy_manifold(found, m);
+      // Read from the narrow phase's slot, not the fresh copy: a load from a block just copied
+      // waits for the copy's stores to retire.
+      while (old < previous_manifolds_.size() &&
+             PartPair{previous_manifolds_[old].part_a, previous_manifolds_[old].part_b} < pair)
+        ++old;
+      if (old < previous_manifolds_.size() && previous_manifolds_[old].part_a == pair.a &&
+          previous_manifolds_[old].part_b == pair.b) {
+        const Manifold& prev = previous_manifolds_[old];
+        for (int q = 0; q < found.point_count; ++q) {
+          for (int j = 0; j < prev.point_count; ++j) {
+            const ManifoldPoint& was = prev.points[j];
+            if (was.id != found.points[q].id) continue;
+            // Pressed last step: the bodies are already in contact here, so this is no collision.
+            m.points[q].persistent = was.normal_impulse > 0.0;
+            // Only resting impulses are a good first guess: a collision's impulse is a one-off.
+            if (settings_.warm_start && was.kind == ContactKind::resting) {
+              m.points[q].normal_impulse = was.normal_impulse;
+              m.points[q].tangent_impulse = was.tangent_impulse;
+            }
           }
         }
       }
+      // Classified here, while the manifold is at hand (one pass over the contact list, not three).
+      prepare_contact(m, bodies_, dt_, contact_.collision_threshold);
     }
-    // Classified here, while the manifold is at hand (one pass over the contact list, not three).
-    prepare_contact(m, bodies_, dt_, contact_.collision_threshold);
-  }
+  });
   manifolds_.resize(contacts);
   std::swap(narrow_, previous_narrow_);
   std::swap(narrow_hint_, previous_hint_);
@@ -748,14 +771,16 @@ void NativeEngine::apply_loads(const Loads& loads) {
   if (!loads.velocity_turn.empty())
     for (std::size_t i = 0; i < nb; ++i) bodies_.velocity[i] = loads.velocity_turn[i].apply(bodies_.velocity[i]);
   if (!loads.any) return;
-  for (std::size_t i = 0; i < nb; ++i) {
-    bodies_.velocity[i] += (dt_ * bodies_.inv_mass[i]) * loads.force[i];
-    bodies_.angular_velocity[i] += dt_ * bodies_.inv_inertia[i] * loads.torque[i];
-  }
+  thread_pool().for_blocks(nb, 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      bodies_.velocity[i] += (dt_ * bodies_.inv_mass[i]) * loads.force[i];
+      bodies_.angular_velocity[i] += dt_ * bodies_.inv_inertia[i] * loads.torque[i];
+    }
+  });
 }
 
 void NativeEngine::integrate() {
-  thread_pool().for_blocks(bodies_.position.size(), 16384, [&](std::size_t begin, std::size_t end) {
+  thread_pool().for_blocks(bodies_.position.size(), 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       if (!moves_[i]) continue;
       bodies_.position[i] += dt_ * bodies_.velocity[i];

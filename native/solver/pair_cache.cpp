@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "parallel/thread_pool.hpp"
+
 namespace floedem {
 
 namespace {
@@ -30,13 +32,20 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
     moved_.assign(n, 0);
     stale_list_.clear();
   }
+  // Per part (blocks on the pool's threads): a new fat box where it left its own; then, in
+  // part order, the list of those that did.
+  left_.resize(n);
+  thread_pool().for_blocks(n, 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      left_[k] = full || !inside(boxes[k], fat_[k]);
+      if (!left_[k]) continue;
+      const Vec2 m{margin[k], margin[k]};
+      fat_[k] = {boxes[k].lo - m, boxes[k].hi + m};
+    }
+  });
   moved_list_.clear();
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!full && inside(boxes[k], fat_[k])) continue;
-    const Vec2 m{margin[k], margin[k]};
-    fat_[k] = {boxes[k].lo - m, boxes[k].hi + m};
-    moved_list_.push_back(static_cast<std::int32_t>(k));
-  }
+  for (std::size_t k = 0; k < n; ++k)
+    if (left_[k]) moved_list_.push_back(static_cast<std::int32_t>(k));
   refreshed_ += static_cast<std::int64_t>(moved_list_.size());
   if (!full) {
     for (const std::int32_t k : moved_list_)
@@ -50,10 +59,19 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
     rebuild(body, fixed);
   else if (!moved_list_.empty())
     refresh(body, fixed);
-  // The pairs of this step: candidates whose step boxes overlap (candidates are sorted).
+  // The pairs of this step: candidates whose step boxes overlap (candidates are sorted), found
+  // by blocks of candidates on the pool's threads and joined in block order.
+  constexpr std::size_t kGrain = 16384;
+  const std::size_t blocks = (candidates_.size() + kGrain - 1) / kGrain;
+  if (overlapping_.size() < blocks) overlapping_.resize(blocks);
+  thread_pool().for_blocks(candidates_.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+    std::vector<PartPair>& found = overlapping_[begin / kGrain];
+    found.clear();
+    for (std::size_t k = begin; k < end; ++k)
+      if (boxes[candidates_[k].a].overlaps(boxes[candidates_[k].b])) found.push_back(candidates_[k]);
+  });
   out.clear();
-  for (const PartPair& p : candidates_)
-    if (boxes[p.a].overlaps(boxes[p.b])) out.push_back(p);
+  for (std::size_t b = 0; b < blocks; ++b) out.insert(out.end(), overlapping_[b].begin(), overlapping_[b].end());
 }
 
 void PairCache::parts_near(const Aabb& box, std::vector<std::int32_t>& out) const {

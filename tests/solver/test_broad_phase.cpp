@@ -2,14 +2,21 @@
 
 #include <random>
 
+#include "parallel/thread_pool.hpp"
+#include "parallel/threads.hpp"
 #include "solver/broad_phase.hpp"
 #include "solver/pair_cache.hpp"
 
 using namespace floedem;
 
 TEST_CASE("broad phase finds exactly the overlapping pairs, once each, sorted", "[broad]") {
-  // Sizes spread over two decades and a few very large parts (an iceberg), against brute force.
-  for (const int n : {5, 30, 400, 3000}) {
+  // Sizes spread over two decades and a few very large parts (an iceberg), against brute force,
+  // on one thread and on three (blocks of cells and of parts, their lists merged: 20 000 parts
+  // make several blocks of each).
+  const unsigned threads = GENERATE(1u, 3u);
+  set_thread_pool_size(threads);
+  INFO("threads " << threads);
+  for (const int n : {5, 30, 400, 3000, 20000}) {
     std::mt19937_64 rng(static_cast<unsigned>(n));
     std::uniform_real_distribution<double> pos(-500.0, 500.0), u(0.0, 1.0);
     std::vector<Aabb> boxes;
@@ -33,6 +40,7 @@ TEST_CASE("broad phase finds exactly the overlapping pairs, once each, sorted", 
     bp.find_pairs(boxes, body, fixed, got);  // reuse of the buffers
     CHECK(got == expected);
   }
+  set_thread_pool_size(worker_threads());
 }
 
 TEST_CASE("a lone part builds no pairs", "[broad]") {
@@ -48,8 +56,12 @@ TEST_CASE("a lone part builds no pairs", "[broad]") {
 TEST_CASE("pair cache: every step the same pairs as a fresh broad phase", "[broad]") {
   // Parts at rest, creeping, drifting fast and jumping (a teleport leaves its fat box at once),
   // a large iceberg-like part sweeping through, many steps: the coherent cache must hand out
-  // exactly what a full rebuild finds, in the same order, at every step.
-  for (const int n : {10, 300, 2000}) {
+  // exactly what a full rebuild finds, in the same order, at every step; on one thread and on
+  // three (20 000 parts: several blocks of parts and of candidates).
+  const unsigned threads = GENERATE(1u, 3u);
+  set_thread_pool_size(threads);
+  INFO("threads " << threads);
+  for (const int n : {10, 300, 2000, 20000}) {
     std::mt19937_64 rng(static_cast<unsigned>(n) + 7);
     std::uniform_real_distribution<double> pos(-300.0, 300.0), u(0.0, 1.0), s(-1.0, 1.0);
     std::vector<Vec2> centre(n), velocity(n), half(n);
@@ -92,4 +104,5 @@ TEST_CASE("pair cache: every step the same pairs as a fresh broad phase", "[broa
       CHECK(cache.refreshed_parts() > 150);   // and it did refresh parts in between
     }
   }
+  set_thread_pool_size(worker_threads());
 }
