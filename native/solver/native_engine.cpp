@@ -513,7 +513,9 @@ void NativeEngine::build_manifolds() {
       m.restitution = contact_.restitution;
       collide_parts(pair, part_reach_[pair.a], part_reach_[pair.b], m, &narrow_hint_[k]);
     }
-    std::size_t found = 0;  // the block's contacts, for their places in the list
+    // The block's contacts, for their places in the list (run inline, one call covers every
+    // pair and writes the first count alone; the prefix sum below gives the same offsets).
+    std::size_t found = 0;
     for (std::size_t k = begin; k < end; ++k) found += narrow_[k].point_count != 0;
     block_contacts_[begin / kPairGrain + 1] = found;
   });

@@ -106,3 +106,40 @@ TEST_CASE("pair cache: every step the same pairs as a fresh broad phase", "[broa
   }
   set_thread_pool_size(worker_threads());
 }
+
+TEST_CASE("broad phase and pair cache keep no pairs of an earlier call when the threads change", "[broad]") {
+  // A call on three threads fills several blocks' lists; the next, on one thread, runs each
+  // loop inline as one call: lists it does not fill must not hand out the earlier pairs.
+  auto field = [](int n, double shift, std::vector<Aabb>& boxes) {
+    std::mt19937_64 rng(static_cast<unsigned>(n));
+    std::uniform_real_distribution<double> pos(-600.0, 600.0), u(0.0, 1.0);
+    boxes.clear();
+    for (int i = 0; i < n; ++i) {
+      const double size = 2.0 * std::pow(10.0, 1.2 * u(rng));
+      const Vec2 c{pos(rng) + shift, pos(rng)};
+      boxes.push_back({c - Vec2{size / 2, size / 2}, c + Vec2{size / 2, size / 2}});
+    }
+  };
+  const int n = 20000;
+  std::vector<std::int32_t> body(n);
+  for (int i = 0; i < n; ++i) body[i] = i;
+  const std::vector<std::uint8_t> fixed(n, 0);
+  const std::vector<double> margin(n, 0.5);
+  std::vector<Aabb> first, second;
+  field(n, 0.0, first);
+  field(n, 1.0, second);  // the same boxes moved: many pairs differ from the first call's
+  BroadPhase bp, fresh;
+  PairCache cache;
+  std::vector<PartPair> got, cached, expected;
+  set_thread_pool_size(3);
+  bp.find_pairs(first, body, fixed, got);
+  cache.find_pairs(first, margin, body, fixed, cached);
+  set_thread_pool_size(1);
+  bp.find_pairs(second, body, fixed, got);
+  cache.find_pairs(second, margin, body, fixed, cached);
+  set_thread_pool_size(worker_threads());
+  fresh.find_pairs(second, body, fixed, expected);
+  CHECK(!expected.empty());
+  CHECK(got == expected);
+  CHECK(cached == expected);
+}
