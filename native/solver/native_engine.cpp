@@ -490,6 +490,11 @@ void NativeEngine::build_manifolds() {
   const std::size_t blocks = (pairs_.size() + kPairGrain - 1) / kPairGrain;
   block_contacts_.assign(blocks + 1, 0);
   thread_pool().for_blocks(pairs_.size(), kPairGrain, [&](std::size_t begin, std::size_t end) {
+    // The block's contacts, counted as each slot is written (a second pass would reread every
+    // slot; run inline on one thread, that is the whole list, 20 MB at 16k floes): they place
+    // the block's contacts in the list. Run inline, one call covers every pair and writes the
+    // first count alone; the prefix sum below gives the same offsets.
+    std::size_t found = 0;
     for (std::size_t k = begin; k < end; ++k) {
       if (may_reuse && reuse_[k] >= 0) {
         const Manifold& was = previous_narrow_[static_cast<std::size_t>(reuse_[k])];
@@ -498,6 +503,7 @@ void NativeEngine::build_manifolds() {
           narrow_[k].point_count = 0;
         else
           copy_manifold(was, narrow_[k]);
+        found += was.point_count != 0;
         continue;
       }
       const PartPair pair = pairs_[k];
@@ -512,11 +518,8 @@ void NativeEngine::build_manifolds() {
       m.friction = contact_.friction;
       m.restitution = contact_.restitution;
       collide_parts(pair, part_reach_[pair.a], part_reach_[pair.b], m, &narrow_hint_[k]);
+      found += m.point_count != 0;
     }
-    // The block's contacts, for their places in the list (run inline, one call covers every
-    // pair and writes the first count alone; the prefix sum below gives the same offsets).
-    std::size_t found = 0;
-    for (std::size_t k = begin; k < end; ++k) found += narrow_[k].point_count != 0;
     block_contacts_[begin / kPairGrain + 1] = found;
   });
   // The contacts, in pair order, each into its slot of the list: per block of pairs (the
