@@ -39,14 +39,15 @@ class ThreadPool {
   unsigned size() const { return static_cast<unsigned>(workers_.size()) + 1; }
 
   /// Calls fn(begin, end) for consecutive blocks of at most `grain` indices covering [0, n),
-  /// spread over the threads; returns when all are done. Inline when one block covers it.
+  /// spread over the threads; returns when all are done. The blocks are the same on one
+  /// thread (the caller takes them in order), so state kept per block (begin / grain) is too.
   /// One loop at a time: fn must not call for_blocks.
   template <class F>
   void for_blocks(std::size_t n, std::size_t grain, F&& fn) {
     grain = std::max<std::size_t>(grain, 1);
     const std::size_t blocks = (n + grain - 1) / grain;
     if (blocks <= 1 || workers_.empty()) {
-      if (n > 0) fn(std::size_t{0}, n);
+      for (std::size_t b = 0; b < blocks; ++b) fn(b * grain, std::min(n, (b + 1) * grain));
       return;
     }
     struct Job {

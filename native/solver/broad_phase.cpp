@@ -136,9 +136,6 @@ void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::in
   const std::size_t cell_blocks = (all_cells + kCellGrain - 1) / kCellGrain;
   const std::size_t part_blocks = (static_cast<std::size_t>(n) + kPartGrain - 1) / kPartGrain;
   if (found_.size() < cell_blocks + part_blocks) found_.resize(cell_blocks + part_blocks);
-  // Emptied here, not only by their blocks: a loop run inline (one thread) is one call that
-  // fills the first list of its range alone, and the rest must not keep an earlier call's pairs.
-  for (std::size_t b = 0; b < cell_blocks + part_blocks; ++b) found_[b].clear();
   thread_pool().for_blocks(all_cells, kCellGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<PartPair>& found = found_[begin / kCellGrain];
     found.clear();

@@ -31,6 +31,12 @@ namespace floedem {
 
 namespace {
 
+/// Where `pair` is, or would go, in a contact list sorted by (part_a, part_b).
+std::vector<Manifold>::const_iterator find_pair(const std::vector<Manifold>& list, PartPair pair) {
+  return std::lower_bound(list.begin(), list.end(), pair,
+                          [](const Manifold& m, PartPair p) { return PartPair{m.part_a, m.part_b} < p; });
+}
+
 class NativeEngine final : public Engine {
  public:
   explicit NativeEngine(const Scene& scene);
@@ -373,9 +379,7 @@ bool NativeEngine::meets_unseen_contact() {
         const PartPair pair{std::min(j, k), std::max(j, k)};
         collide_parts(pair, reach_of_part(pair.a), reach_of_part(pair.b), probe);
         if (probe.point_count == 0) continue;
-        const auto held = std::lower_bound(manifolds_.begin(), manifolds_.end(), pair, [](const Manifold& m, PartPair p) {
-          return PartPair{m.part_a, m.part_b} < p;
-        });
+        const auto held = find_pair(manifolds_, pair);
         const bool pair_held = held != manifolds_.end() && held->part_a == pair.a && held->part_b == pair.b;
         for (int q = 0; q < probe.point_count && !unseen; ++q) {
           const ManifoldPoint& p = probe.points[q];
@@ -491,9 +495,7 @@ void NativeEngine::build_manifolds() {
   block_contacts_.assign(blocks + 1, 0);
   thread_pool().for_blocks(pairs_.size(), kPairGrain, [&](std::size_t begin, std::size_t end) {
     // The block's contacts, counted as each slot is written (a second pass would reread every
-    // slot; run inline on one thread, that is the whole list, 20 MB at 16k floes): they place
-    // the block's contacts in the list. Run inline, one call covers every pair and writes the
-    // first count alone; the prefix sum below gives the same offsets.
+    // slot, out of cache at 16k floes): they place the block's contacts in the list.
     std::size_t found = 0;
     for (std::size_t k = begin; k < end; ++k) {
       if (may_reuse && reuse_[k] >= 0) {
@@ -524,7 +526,6 @@ void NativeEngine::build_manifolds() {
   });
   // The contacts, in pair order, each into its slot of the list: per block of pairs (the
   // narrow phase's blocks), its first slot is the count of contacts in the blocks before it.
-  // (each narrow-phase block counted its own).
   for (std::size_t b = 0; b < blocks; ++b) block_contacts_[b + 1] += block_contacts_[b];
   const std::size_t contacts = block_contacts_[blocks];
   if (manifolds_.size() < contacts) manifolds_.resize(contacts);
@@ -534,10 +535,7 @@ void NativeEngine::build_manifolds() {
   // manifold and the bodies alone: the same list on any number of threads.
   thread_pool().for_blocks(pairs_.size(), kPairGrain, [&](std::size_t begin, std::size_t end) {
     std::size_t slot = block_contacts_[begin / kPairGrain];
-    auto old = static_cast<std::size_t>(
-        std::lower_bound(previous_manifolds_.begin(), previous_manifolds_.end(), pairs_[begin],
-                         [](const Manifold& m, PartPair p) { return PartPair{m.part_a, m.part_b} < p; }) -
-        previous_manifolds_.begin());
+    auto old = static_cast<std::size_t>(find_pair(previous_manifolds_, pairs_[begin]) - previous_manifolds_.begin());
     for (std::size_t k = begin; k < end; ++k) {
       const PartPair pair = pairs_[k];
       const Manifold& found = narrow_[k];  // narrow_ keeps the narrow phase's own result (reuse)

@@ -64,7 +64,6 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
   constexpr std::size_t kGrain = 16384;
   const std::size_t blocks = (candidates_.size() + kGrain - 1) / kGrain;
   if (overlapping_.size() < blocks) overlapping_.resize(blocks);
-  for (std::size_t b = 0; b < blocks; ++b) overlapping_[b].clear();  // inline (one thread): one call fills the first
   thread_pool().for_blocks(candidates_.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<PartPair>& found = overlapping_[begin / kGrain];
     found.clear();

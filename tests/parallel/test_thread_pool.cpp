@@ -25,9 +25,8 @@ void check_every_index_once(ThreadPool& pool, int loops) {
     const std::size_t n = sizes[loop % 7], grain = grains[(loop / 7) % 4];
     for (std::size_t i = 0; i < n; ++i) visits[i].store(0, std::memory_order_relaxed);
     pool.for_blocks(n, grain, [&](std::size_t begin, std::size_t end) {
-      // A block is [k grain, min(n, (k + 1) grain)) (one block when the loop runs inline).
-      const bool inline_run = begin == 0 && end == n;
-      if (!inline_run && (begin % grain != 0 || end != std::min(n, begin + grain))) bad_blocks.fetch_add(1);
+      // A block is [k grain, min(n, (k + 1) grain)), on one thread as on several.
+      if (begin % grain != 0 || end != std::min(n, begin + grain)) bad_blocks.fetch_add(1);
       for (std::size_t i = begin; i < end; ++i) visits[i].fetch_add(1, std::memory_order_relaxed);
     });
     // for_blocks has returned: every block's writes are visible here.

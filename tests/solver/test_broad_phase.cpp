@@ -108,8 +108,8 @@ TEST_CASE("pair cache: every step the same pairs as a fresh broad phase", "[broa
 }
 
 TEST_CASE("broad phase and pair cache keep no pairs of an earlier call when the threads change", "[broad]") {
-  // A call on three threads fills several blocks' lists; the next, on one thread, runs each
-  // loop inline as one call: lists it does not fill must not hand out the earlier pairs.
+  // A call on three threads fills several blocks' lists; the next, on one thread, has other
+  // data: no list may hand out the earlier call's pairs.
   auto field = [](int n, double shift, std::vector<Aabb>& boxes) {
     std::mt19937_64 rng(static_cast<unsigned>(n));
     std::uniform_real_distribution<double> pos(-600.0, 600.0), u(0.0, 1.0);
