@@ -143,11 +143,6 @@ struct AllRows {
   std::size_t size() const { return m.size(); }
   Manifold& operator[](std::size_t i) const { return m[i]; }
 };
-struct ReadRows {
-  std::span<const Manifold> m;
-  std::size_t size() const { return m.size(); }
-  const Manifold& operator[](std::size_t i) const { return m[i]; }
-};
 struct IslandRows {
   std::span<Manifold> m;
   std::span<const std::int32_t> index;
@@ -155,11 +150,9 @@ struct IslandRows {
   Manifold& operator[](std::size_t i) const { return m[static_cast<std::size_t>(index[i])]; }
 };
 
-template <class Rows>
-double largest_shortfall_of(const Rows& rows, const BodyArrays& s) {
+double largest_shortfall_of(std::span<const Manifold> manifolds, const BodyArrays& s) {
   double worst = 0.0;
-  for (std::size_t mi = 0; mi < rows.size(); ++mi) {
-    const Manifold& m = rows[mi];
+  for (const Manifold& m : manifolds) {
     for (int k = 0; k < m.point_count; ++k) {
       const ManifoldPoint& p = m.points[k];
       worst = std::max(worst, p.target_velocity - dot(relative_velocity(s, m.body_a, m.body_b, p.ra, p.rb), m.normal));
@@ -168,19 +161,62 @@ double largest_shortfall_of(const Rows& rows, const BodyArrays& s) {
   return worst;
 }
 
+// The same over the rows (the same points in the same order).
+double largest_shortfall_of(std::span<const SweepRow> rows, const BodyArrays& s) {
+  double worst = 0.0;
+  for (const SweepRow& r : rows)
+    worst = std::max(worst, r.target_velocity - dot(relative_velocity(s, r.body_a, r.body_b, r.ra, r.rb), r.normal));
+  return worst;
+}
+
+inline void apply_row_impulse(BodyArrays& s, const SweepRow& r, Vec2 impulse) {
+  apply_impulse(s, r.body_a, r.body_b, r.ra, r.rb, impulse);
+}
+
+// The manifolds' points as rows, in sweep order; with the warm start, each point's accumulated
+// impulse applied as it is copied (apply_accumulated_impulses' order and arithmetic).
 template <class Rows>
-int run_sweeps(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, SweepMomentum* momentum) {
-  if (momentum) {
-    // Room for half as many manifolds again: no allocation each time a pack gains a contact.
-    const std::size_t n = 4 * manifolds.size();
-    if (momentum->direction.capacity() < n) {
-      momentum->change.reserve(n + n / 2);
-      momentum->direction.reserve(n + n / 2);
-      momentum->step.reserve(n + n / 2);
+void gather_rows(const Rows& manifolds, BodyArrays& s, bool warm_start, std::vector<SweepRow>& rows) {
+  rows.clear();
+  for (std::size_t mi = 0; mi < manifolds.size(); ++mi) {
+    const Manifold& m = manifolds[mi];
+    const Vec2 t = perp(m.normal);
+    for (int k = 0; k < m.point_count; ++k) {
+      const ManifoldPoint& p = m.points[k];
+      rows.push_back({m.body_a, m.body_b, m.normal, p.ra, p.rb, p.wnn, p.wnt, p.wtt, p.target_velocity, m.friction,
+                      p.normal_impulse, p.tangent_impulse});
+      if (warm_start && (p.normal_impulse != 0.0 || p.tangent_impulse != 0.0))
+        apply_impulse(s, m, p, 1.0 * (p.normal_impulse * m.normal + p.tangent_impulse * t));
     }
-    momentum->change.assign(n, 0.0);  // a manifold's absent second point stays 0
-    momentum->direction.assign(n, 0.0);
-    momentum->step.resize(n);
+  }
+}
+
+// The rows' impulses back into their manifolds' points.
+template <class Rows>
+void scatter_rows(const Rows& manifolds, std::span<const SweepRow> rows) {
+  std::size_t x = 0;
+  for (std::size_t mi = 0; mi < manifolds.size(); ++mi) {
+    Manifold& m = manifolds[mi];
+    for (int k = 0; k < m.point_count; ++k, ++x) {
+      m.points[k].normal_impulse = rows[x].normal_impulse;
+      m.points[k].tangent_impulse = rows[x].tangent_impulse;
+    }
+  }
+}
+
+int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limits, SweepWork& work,
+               bool accelerate) {
+  if (accelerate) {
+    // Room for half as many rows again: no allocation each time a pack gains a contact.
+    const std::size_t n = 2 * rows.size();
+    if (work.direction.capacity() < n) {
+      work.change.reserve(n + n / 2);
+      work.direction.reserve(n + n / 2);
+      work.step.reserve(n + n / 2);
+    }
+    work.change.assign(n, 0.0);
+    work.direction.assign(n, 0.0);
+    work.step.resize(n);
   }
   double previous_size = 0.0;  // |r_k|^2; 0 before the first sweep
   int max_iterations = limits.iterations;
@@ -190,48 +226,45 @@ int run_sweeps(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, 
     double largest_change = 0.0;
     double largest_impulse = 0.0;
     double size = 0.0;  // |r_{k+1}|^2
-    for (std::size_t mi = 0; mi < manifolds.size(); ++mi) {
-      Manifold& m = manifolds[mi];
-      const Vec2 n = m.normal;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      SweepRow& p = rows[i];
+      const Vec2 n = p.normal;
       const Vec2 t = perp(n);
-      for (int k = 0; k < m.point_count; ++k) {
-        ManifoldPoint& p = m.points[k];
-        const Vec2 u = relative_velocity(s, m.body_a, m.body_b, p.ra, p.rb);
-        const double pn0 = p.normal_impulse, pt0 = p.tangent_impulse;
-        // Velocity without this point's own impulse.
-        const double ufn = dot(u, n) - (p.wnn * pn0 + p.wnt * pt0);
-        const double uft = dot(u, t) - (p.wnt * pn0 + p.wtt * pt0);
-        const LocalImpulse r = local_impulse(ufn, uft, p.target_velocity, m.friction, p.wnn, p.wnt, p.wtt);
-        const double dpn = r.normal - pn0, dpt = r.tangent - pt0;
-        if (dpn != 0.0 || dpt != 0.0) apply_impulse(s, m, p, dpn * n + dpt * t);
-        p.normal_impulse = r.normal;
-        p.tangent_impulse = r.tangent;
-        largest_change = std::max(largest_change, std::abs(dpn) + std::abs(dpt));
-        largest_impulse = std::max(largest_impulse, r.normal + std::abs(r.tangent));
-        if (momentum) {
-          momentum->change[4 * mi + 2 * k] = dpn;
-          momentum->change[4 * mi + 2 * k + 1] = dpt;
-          size += dpn * dpn + dpt * dpt;
-        }
+      const Vec2 u = relative_velocity(s, p.body_a, p.body_b, p.ra, p.rb);
+      const double pn0 = p.normal_impulse, pt0 = p.tangent_impulse;
+      // Velocity without this point's own impulse.
+      const double ufn = dot(u, n) - (p.wnn * pn0 + p.wnt * pt0);
+      const double uft = dot(u, t) - (p.wnt * pn0 + p.wtt * pt0);
+      const LocalImpulse r = local_impulse(ufn, uft, p.target_velocity, p.friction, p.wnn, p.wnt, p.wtt);
+      const double dpn = r.normal - pn0, dpt = r.tangent - pt0;
+      if (dpn != 0.0 || dpt != 0.0) apply_row_impulse(s, p, dpn * n + dpt * t);
+      p.normal_impulse = r.normal;
+      p.tangent_impulse = r.tangent;
+      largest_change = std::max(largest_change, std::abs(dpn) + std::abs(dpt));
+      largest_impulse = std::max(largest_impulse, r.normal + std::abs(r.tangent));
+      if (accelerate) {
+        work.change[2 * i] = dpn;
+        work.change[2 * i + 1] = dpt;
+        size += dpn * dpn + dpt * dpt;
       }
     }
     if (largest_change <= limits.tolerance * largest_impulse) break;
     if (sweep >= limits.iterations && (sweep - limits.iterations) % kCheckEvery == 0 && limits.extra_iterations > 0) {
-      if (largest_shortfall_of(manifolds, s) <= limits.closing_speed) break;
+      if (largest_shortfall_of(rows, s) <= limits.closing_speed) break;
       max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
     }
-    if (!momentum || sweep == max_iterations) continue;
-    std::vector<double>& p = momentum->direction;
-    const std::vector<double>& r = momentum->change;
+    if (!accelerate || sweep == max_iterations) continue;
+    std::vector<double>& p = work.direction;
+    const std::vector<double>& r = work.change;
     if (previous_size > 0.0 && size > previous_size) {
       std::fill(p.begin(), p.end(), 0.0);  // the merit rose: restart
     } else {
       const double beta = previous_size > 0.0 ? size / previous_size : 0.0;
       // Over the dense arrays, in two passes: the step beta p and the new direction (a loop
       // the compiler vectorises), then the step applied where it is not zero: a point that
-      // neither moved nor carries a direction (a speculative contact kept apart, an absent
-      // second point) costs no look at its manifold.
-      std::vector<double>& step = momentum->step;
+      // neither moved nor carries a direction (a speculative contact kept apart) costs no look
+      // at its row.
+      std::vector<double>& step = work.step;
       for (std::size_t i = 0; i < p.size(); ++i) {
         step[i] = beta * p[i];
         p[i] = step[i] + r[i];
@@ -239,9 +272,8 @@ int run_sweeps(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, 
       for (std::size_t i = 0; i < p.size(); i += 2) {
         const double sn = step[i], st = step[i + 1];
         if (sn == 0.0 && st == 0.0) continue;
-        const Manifold& m = manifolds[i / 4];
-        ManifoldPoint& q = manifolds[i / 4].points[(i / 2) % 2];
-        apply_impulse(s, m, q, sn * m.normal + st * perp(m.normal));
+        SweepRow& q = rows[i / 2];
+        apply_row_impulse(s, q, sn * q.normal + st * perp(q.normal));
         q.normal_impulse += sn;
         q.tangent_impulse += st;
       }
@@ -251,25 +283,29 @@ int run_sweeps(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, 
   return sweep;
 }
 
+template <class Rows>
+int solve_rows(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, SweepWork& work,
+               SweepOptions options) {
+  gather_rows(manifolds, s, options.warm_start, work.rows);
+  const int sweeps = run_sweeps(work.rows, s, limits, work, options.accelerate);
+  scatter_rows(manifolds, work.rows);
+  return sweeps;
+}
+
 }  // namespace
 
 double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& s) {
-  return largest_shortfall_of(ReadRows{manifolds}, s);
+  return largest_shortfall_of(manifolds, s);
 }
 
-int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits,
-                     SweepMomentum* momentum) {
-  return run_sweeps(AllRows{manifolds}, s, limits, momentum);
+int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepWork& work,
+                     SweepOptions options) {
+  return solve_rows(AllRows{manifolds}, s, limits, work, options);
 }
 
 int solve_velocities(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& s,
-                     const SweepLimits& limits, SweepMomentum* momentum) {
-  return run_sweeps(IslandRows{manifolds, island}, s, limits, momentum);
-}
-
-void apply_accumulated_impulses(std::span<const Manifold> manifolds, std::span<const std::int32_t> island,
-                                BodyArrays& s, double sign) {
-  for (const std::int32_t i : island) apply_accumulated_impulses(manifolds.subspan(static_cast<std::size_t>(i), 1), s, sign);
+                     const SweepLimits& limits, SweepWork& work, SweepOptions options) {
+  return solve_rows(IslandRows{manifolds, island}, s, limits, work, options);
 }
 
 int clamp_friction(std::span<Manifold> manifolds, BodyArrays& s) {

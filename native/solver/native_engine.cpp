@@ -124,7 +124,7 @@ class NativeEngine final : public Engine {
   /// What one block of islands works in, on whichever thread takes it (no allocation per step
   /// once sized), and what it reports back.
   struct IslandWork {
-    SweepMomentum momentum;         // the accelerated sweeps' work arrays
+    SweepWork sweeps;               // the sweeps' rows and work arrays
     std::vector<Vec2> velocity;     // an island's bodies' velocities before its solve (cold restart)
     std::vector<double> angular_velocity;
     int longest = 0;        // most sweeps an island of the block took
@@ -138,6 +138,7 @@ class NativeEngine final : public Engine {
   std::vector<double> saved_impulses_;
   std::vector<std::int32_t> island_index_;  // the manifolds of the islands solved directly
   std::vector<Manifold> island_manifolds_;  // ... copied out for their sweeps
+  SweepWork direct_sweeps_;                 // ... and the rows of those sweeps
   IslandSolver island_solver_;
   /// The sweeps' limits: extra sweeps while a point would close by more than the allowed overlap within the step.
   SweepLimits sweep_limits() const {
@@ -633,9 +634,8 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
       work.angular_velocity.push_back(bodies_.angular_velocity[b]);
     }
   }
-  if (settings_.warm_start) apply_accumulated_impulses(manifolds_, manifolds, bodies_, 1.0);
-  int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(),
-                                settings_.accelerate ? &work.momentum : nullptr);
+  int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), work.sweeps,
+                                {.warm_start = settings_.warm_start, .accelerate = settings_.accelerate});
   if (!checked) return sweeps;
   double pushed = 0.0;  // the work of towed bodies on this island's floes (contacts_gain_energy)
   if (has_prescribed_)
@@ -649,7 +649,7 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
     Manifold& m = manifolds_[k];
     for (int j = 0; j < m.point_count; ++j) m.points[j].normal_impulse = m.points[j].tangent_impulse = 0.0;
   }
-  sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits());  // plain sweeps: no energy made
+  sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), work.sweeps);  // plain sweeps: no energy made
   ++work.cold_restarts;
   return sweeps;
 }
@@ -703,7 +703,8 @@ void NativeEngine::solve_islands_directly(double before) {
            island_solver_.solve(island_manifolds_, bodies_, /*without_friction=*/false);
   };
   for (int pass = 0; pass < 3; ++pass) {
-    total_sweeps_ += solve_velocities(island_manifolds_, bodies_, {settings_.velocity_iterations, settings_.tolerance});
+    total_sweeps_ +=
+        solve_velocities(island_manifolds_, bodies_, {settings_.velocity_iterations, settings_.tolerance}, direct_sweeps_);
     if (!solve_normals_again()) break;
   }
   for (int round = 0; round < kFrictionRounds && clamp_friction(island_manifolds_, bodies_) > 0; ++round)

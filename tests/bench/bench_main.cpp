@@ -239,7 +239,8 @@ struct PackedField {
       manifolds.push_back(m);
     }
     BodyArrays scratch = bodies;
-    solve_velocities(manifolds, scratch, limits);
+    SweepWork work;
+    solve_velocities(manifolds, scratch, limits, work);
   }
 };
 
@@ -258,14 +259,14 @@ void BM_ContactSweeps(benchmark::State& state) {
   std::size_t points = 0;
   for (const Manifold& m : manifolds) points += static_cast<std::size_t>(m.point_count);
   int sweeps = 0;
+  SweepWork work;
   for (auto _ : state) {
     state.PauseTiming();
     manifolds = field.manifolds;
     bodies.velocity = field.bodies.velocity;
     bodies.angular_velocity = field.bodies.angular_velocity;
     state.ResumeTiming();
-    warm_start(manifolds, bodies);
-    sweeps = solve_velocities(manifolds, bodies, field.limits);
+    sweeps = solve_velocities(manifolds, bodies, field.limits, work, {.warm_start = true});
     benchmark::DoNotOptimize(bodies.velocity.data());
   }
   state.counters["manifolds"] = static_cast<double>(manifolds.size());
