@@ -25,6 +25,9 @@ class ContactIslands {
   std::span<const std::int32_t> manifolds(std::size_t i) const {
     return {manifold_.data() + manifold_start_[i], manifold_.data() + manifold_start_[i + 1]};
   }
+  /// Where island i's manifolds start in the islands' list of all (islands in order, so the
+  /// islands' [offset, offset + size) ranges tile [0, manifolds given to build)).
+  std::size_t manifold_offset(std::size_t i) const { return static_cast<std::size_t>(manifold_start_[i]); }
   /// Island i's moving bodies (ascending).
   std::span<const std::int32_t> bodies(std::size_t i) const {
     return {body_.data() + body_start_[i], body_.data() + body_start_[i + 1]};

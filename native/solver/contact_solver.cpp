@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <type_traits>
 
 // Contact constraint, per point, between bodies a and b (normal n from a to b, tangent t = k x n):
 //
@@ -176,19 +178,20 @@ inline void apply_row_impulse(BodyArrays& s, const SweepRow& r, Vec2 impulse) {
 // The manifolds' points as rows, in sweep order; with the warm start, each point's accumulated
 // impulse applied as it is copied (apply_accumulated_impulses' order and arithmetic).
 template <class Rows>
-void gather_rows(const Rows& manifolds, BodyArrays& s, bool warm_start, std::vector<SweepRow>& rows) {
-  rows.clear();
+std::size_t gather_rows(const Rows& manifolds, BodyArrays& s, bool warm_start, std::span<SweepRow> rows) {
+  std::size_t x = 0;
   for (std::size_t mi = 0; mi < manifolds.size(); ++mi) {
     const Manifold& m = manifolds[mi];
     const Vec2 t = perp(m.normal);
     for (int k = 0; k < m.point_count; ++k) {
       const ManifoldPoint& p = m.points[k];
-      rows.push_back({m.body_a, m.body_b, m.normal, p.ra, p.rb, p.wnn, p.wnt, p.wtt, p.target_velocity, m.friction,
-                      p.normal_impulse, p.tangent_impulse});
+      rows[x++] = {m.body_a, m.body_b, m.normal, p.ra, p.rb, p.wnn, p.wnt, p.wtt, p.target_velocity, m.friction,
+                   p.normal_impulse, p.tangent_impulse};
       if (warm_start && (p.normal_impulse != 0.0 || p.tangent_impulse != 0.0))
         apply_impulse(s, m, p, 1.0 * (p.normal_impulse * m.normal + p.tangent_impulse * t));
     }
   }
+  return x;
 }
 
 // The rows' impulses back into their manifolds' points.
@@ -204,19 +207,14 @@ void scatter_rows(const Rows& manifolds, std::span<const SweepRow> rows) {
   }
 }
 
-int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limits, SweepWork& work,
+int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limits, SweepSpace work,
                bool accelerate) {
   if (accelerate) {
-    // Room for half as many rows again: no allocation each time a pack gains a contact.
-    const std::size_t n = 2 * rows.size();
-    if (work.direction.capacity() < n) {
-      work.change.reserve(n + n / 2);
-      work.direction.reserve(n + n / 2);
-      work.step.reserve(n + n / 2);
-    }
-    work.change.assign(n, 0.0);
-    work.direction.assign(n, 0.0);
-    work.step.resize(n);
+    work.change = work.change.first(2 * rows.size());
+    work.direction = work.direction.first(2 * rows.size());
+    work.step = work.step.first(2 * rows.size());
+    std::fill(work.change.begin(), work.change.end(), 0.0);
+    std::fill(work.direction.begin(), work.direction.end(), 0.0);
   }
   double previous_size = 0.0;  // |r_k|^2; 0 before the first sweep
   int max_iterations = limits.iterations;
@@ -254,8 +252,8 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
       max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
     }
     if (!accelerate || sweep == max_iterations) continue;
-    std::vector<double>& p = work.direction;
-    const std::vector<double>& r = work.change;
+    const std::span<double> p = work.direction;
+    const std::span<const double> r = work.change;
     if (previous_size > 0.0 && size > previous_size) {
       std::fill(p.begin(), p.end(), 0.0);  // the merit rose: restart
     } else {
@@ -264,7 +262,7 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
       // the compiler vectorises), then the step applied where it is not zero: a point that
       // neither moved nor carries a direction (a speculative contact kept apart) costs no look
       // at its row.
-      std::vector<double>& step = work.step;
+      const std::span<double> step = work.step;
       for (std::size_t i = 0; i < p.size(); ++i) {
         step[i] = beta * p[i];
         p[i] = step[i] + r[i];
@@ -284,11 +282,13 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
 }
 
 template <class Rows>
-int solve_rows(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, SweepWork& work,
+int solve_rows(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, SweepSpace space,
                SweepOptions options) {
-  gather_rows(manifolds, s, options.warm_start, work.rows);
-  const int sweeps = run_sweeps(work.rows, s, limits, work, options.accelerate);
-  scatter_rows(manifolds, work.rows);
+  if (space.rows.size() < 2 * manifolds.size() || (options.accelerate && space.change.size() < 4 * manifolds.size()))
+    throw std::logic_error("solve_velocities: the sweep space holds fewer manifolds than the solve");
+  const std::span<SweepRow> rows = space.rows.first(gather_rows(manifolds, s, options.warm_start, space.rows));
+  const int sweeps = run_sweeps(rows, s, limits, space, options.accelerate);
+  scatter_rows(manifolds, rows);
   return sweeps;
 }
 
@@ -298,14 +298,36 @@ double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& 
   return largest_shortfall_of(manifolds, s);
 }
 
-int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepWork& work,
+void SweepWork::reserve(std::size_t manifolds, bool accelerate) {
+  // Half as many again when it grows: no allocation each time a pack gains a contact.
+  auto grow = [](auto& v, std::size_t n) {
+    if (v.size() < n) v.resize(n + n / 2);
+  };
+  grow(rows_, 2 * manifolds);
+  if (accelerate) {
+    grow(change_, 4 * manifolds);
+    grow(direction_, 4 * manifolds);
+    grow(step_, 4 * manifolds);
+  }
+}
+
+SweepSpace SweepWork::slice(std::size_t first, std::size_t count) {
+  auto part = [](auto& v, std::size_t at, std::size_t n) {
+    using T = typename std::remove_reference_t<decltype(v)>::value_type;
+    return v.size() >= at + n ? std::span<T>(v).subspan(at, n) : std::span<T>();
+  };
+  return {part(rows_, 2 * first, 2 * count), part(change_, 4 * first, 4 * count),
+          part(direction_, 4 * first, 4 * count), part(step_, 4 * first, 4 * count)};
+}
+
+int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepSpace space,
                      SweepOptions options) {
-  return solve_rows(AllRows{manifolds}, s, limits, work, options);
+  return solve_rows(AllRows{manifolds}, s, limits, space, options);
 }
 
 int solve_velocities(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& s,
-                     const SweepLimits& limits, SweepWork& work, SweepOptions options) {
-  return solve_rows(IslandRows{manifolds, island}, s, limits, work, options);
+                     const SweepLimits& limits, SweepSpace space, SweepOptions options) {
+  return solve_rows(IslandRows{manifolds, island}, s, limits, space, options);
 }
 
 int clamp_friction(std::span<Manifold> manifolds, BodyArrays& s) {

@@ -65,13 +65,34 @@ struct SweepRow {
   double normal_impulse = 0.0, tangent_impulse = 0.0;  ///< accumulated, N s
 };
 
-/// What a solve works in, kept by the caller (no allocation per step once sized): the rows and,
-/// for the accelerated sweeps, per row (n, t) pairs.
-struct SweepWork {
-  std::vector<SweepRow> rows;
-  std::vector<double> change;     ///< per row (n, t): the impulse change of the last sweep
-  std::vector<double> direction;  ///< per row (n, t): the conjugate direction p
-  std::vector<double> step;       ///< per row (n, t): beta p, the impulse the step adds
+/// Where a solve works: room for its rows (two per manifold at most) and, for the accelerated
+/// sweeps, per row (n, t) pairs (four per manifold). Not owned: slices of a SweepWork, so that
+/// the islands solved side by side share one buffer the size of the step's contacts (a buffer
+/// per block of islands grew, on the 100k field, to a copy of the largest island each).
+struct SweepSpace {
+  std::span<SweepRow> rows;
+  std::span<double> change;     ///< per row (n, t): the impulse change of the last sweep
+  std::span<double> direction;  ///< per row (n, t): the conjugate direction p
+  std::span<double> step;       ///< per row (n, t): beta p, the impulse the step adds
+};
+
+/// The storage behind SweepSpaces, kept by the caller (no allocation per step once sized).
+class SweepWork {
+ public:
+  /// Makes room for `manifolds` manifolds (rows; the accelerated sweeps' arrays too with
+  /// `accelerate`), keeping what is there: a slice handed out before stays valid until the next call.
+  void reserve(std::size_t manifolds, bool accelerate);
+  /// The space of the manifolds [first, first + count) of what reserve() made room for.
+  SweepSpace slice(std::size_t first, std::size_t count);
+  /// reserve(manifolds, accelerate) and the whole of it.
+  SweepSpace space(std::size_t manifolds, bool accelerate) {
+    reserve(manifolds, accelerate);
+    return slice(0, manifolds);
+  }
+
+ private:
+  std::vector<SweepRow> rows_;
+  std::vector<double> change_, direction_, step_;
 };
 
 /// How long the sweeps go on.
@@ -92,12 +113,13 @@ struct SweepOptions {
   bool warm_start = false;
   bool accelerate = false;
 };
-int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, const SweepLimits& limits, SweepWork& work,
+/// `space` must hold manifolds.size() manifolds (and their accelerated arrays with `accelerate`).
+int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, const SweepLimits& limits, SweepSpace space,
                      SweepOptions options = {});
 /// The same over one island's manifolds (indices into `manifolds`, swept in that order):
 /// the sweeps stop on that island's own changes and impulses.
 int solve_velocities(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& bodies,
-                     const SweepLimits& limits, SweepWork& work, SweepOptions options = {});
+                     const SweepLimits& limits, SweepSpace space, SweepOptions options = {});
 
 /// The largest amount by which a point approaches faster than its target (m/s, >= 0).
 double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& bodies);

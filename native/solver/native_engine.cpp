@@ -124,13 +124,13 @@ class NativeEngine final : public Engine {
   /// What one block of islands works in, on whichever thread takes it (no allocation per step
   /// once sized), and what it reports back.
   struct IslandWork {
-    SweepWork sweeps;               // the sweeps' rows and work arrays
     std::vector<Vec2> velocity;     // an island's bodies' velocities before its solve (cold restart)
     std::vector<double> angular_velocity;
     int longest = 0;        // most sweeps an island of the block took
     int cold_restarts = 0;  // islands of the block solved again from zero
   };
   std::vector<IslandWork> island_work_;  // per block of islands
+  SweepWork sweep_work_;  // the islands' sweeps, each in its slice (its manifolds' place in islands_)
   static constexpr std::size_t kIslandGrain = 8;  // islands per block
   static constexpr std::size_t kPairGrain = 512;  // pairs per block (narrow phase, contact list)
   std::vector<Vec2> saved_velocity_;
@@ -138,7 +138,6 @@ class NativeEngine final : public Engine {
   std::vector<double> saved_impulses_;
   std::vector<std::int32_t> island_index_;  // the manifolds of the islands solved directly
   std::vector<Manifold> island_manifolds_;  // ... copied out for their sweeps
-  SweepWork direct_sweeps_;                 // ... and the rows of those sweeps
   IslandSolver island_solver_;
   /// The sweeps' limits: extra sweeps while a point would close by more than the allowed overlap within the step.
   SweepLimits sweep_limits() const {
@@ -594,6 +593,7 @@ void NativeEngine::solve_contacts() {
   const std::size_t n = islands_.size();
   const std::size_t blocks = std::max<std::size_t>(1, (n + kIslandGrain - 1) / kIslandGrain);
   if (island_work_.size() < blocks) island_work_.resize(blocks);
+  sweep_work_.reserve(manifolds_.size(), settings_.accelerate);
   for (IslandWork& w : island_work_) w.longest = w.cold_restarts = 0;
   thread_pool().for_blocks(n, kIslandGrain, [&](std::size_t begin, std::size_t end) {
     IslandWork& w = island_work_[begin / kIslandGrain];
@@ -634,7 +634,8 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
       work.angular_velocity.push_back(bodies_.angular_velocity[b]);
     }
   }
-  int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), work.sweeps,
+  const SweepSpace space = sweep_work_.slice(islands_.manifold_offset(island), manifolds.size());
+  int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,
                                 {.warm_start = settings_.warm_start, .accelerate = settings_.accelerate});
   if (!checked) return sweeps;
   double pushed = 0.0;  // the work of towed bodies on this island's floes (contacts_gain_energy)
@@ -649,7 +650,7 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
     Manifold& m = manifolds_[k];
     for (int j = 0; j < m.point_count; ++j) m.points[j].normal_impulse = m.points[j].tangent_impulse = 0.0;
   }
-  sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), work.sweeps);  // plain sweeps: no energy made
+  sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space);  // plain sweeps: no energy made
   ++work.cold_restarts;
   return sweeps;
 }
@@ -704,7 +705,8 @@ void NativeEngine::solve_islands_directly(double before) {
   };
   for (int pass = 0; pass < 3; ++pass) {
     total_sweeps_ +=
-        solve_velocities(island_manifolds_, bodies_, {settings_.velocity_iterations, settings_.tolerance}, direct_sweeps_);
+        solve_velocities(island_manifolds_, bodies_, {settings_.velocity_iterations, settings_.tolerance},
+                         sweep_work_.space(island_manifolds_.size(), false));
     if (!solve_normals_again()) break;
   }
   for (int round = 0; round < kFrictionRounds && clamp_friction(island_manifolds_, bodies_) > 0; ++round)

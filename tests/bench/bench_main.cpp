@@ -240,7 +240,7 @@ struct PackedField {
     }
     BodyArrays scratch = bodies;
     SweepWork work;
-    solve_velocities(manifolds, scratch, limits, work);
+    solve_velocities(manifolds, scratch, limits, work.space(manifolds.size(), false));
   }
 };
 
@@ -266,7 +266,7 @@ void BM_ContactSweeps(benchmark::State& state) {
     bodies.velocity = field.bodies.velocity;
     bodies.angular_velocity = field.bodies.angular_velocity;
     state.ResumeTiming();
-    sweeps = solve_velocities(manifolds, bodies, field.limits, work, {.warm_start = true});
+    sweeps = solve_velocities(manifolds, bodies, field.limits, work.space(manifolds.size(), false), {.warm_start = true});
     benchmark::DoNotOptimize(bodies.velocity.data());
   }
   state.counters["manifolds"] = static_cast<double>(manifolds.size());
