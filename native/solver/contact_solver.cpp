@@ -152,18 +152,7 @@ struct IslandRows {
   Manifold& operator[](std::size_t i) const { return m[static_cast<std::size_t>(index[i])]; }
 };
 
-double largest_shortfall_of(std::span<const Manifold> manifolds, const BodyArrays& s) {
-  double worst = 0.0;
-  for (const Manifold& m : manifolds) {
-    for (int k = 0; k < m.point_count; ++k) {
-      const ManifoldPoint& p = m.points[k];
-      worst = std::max(worst, p.target_velocity - dot(relative_velocity(s, m.body_a, m.body_b, p.ra, p.rb), m.normal));
-    }
-  }
-  return worst;
-}
-
-// The same over the rows (the same points in the same order).
+// largest_shortfall over the rows (the same points in the same order).
 double largest_shortfall_of(std::span<const SweepRow> rows, const BodyArrays& s) {
   double worst = 0.0;
   for (const SweepRow& r : rows)
@@ -295,7 +284,14 @@ int solve_rows(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, 
 }  // namespace
 
 double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& s) {
-  return largest_shortfall_of(manifolds, s);
+  double worst = 0.0;
+  for (const Manifold& m : manifolds) {
+    for (int k = 0; k < m.point_count; ++k) {
+      const ManifoldPoint& p = m.points[k];
+      worst = std::max(worst, p.target_velocity - dot(relative_velocity(s, m.body_a, m.body_b, p.ra, p.rb), m.normal));
+    }
+  }
+  return worst;
 }
 
 void SweepWork::reserve(std::size_t manifolds, bool accelerate) {

@@ -28,9 +28,9 @@ inline Vec2 relative_velocity(const BodyArrays& s, int a, int b, Vec2 ra, Vec2 r
 /// zero (Newton's law fixes them; a warm start's guess would be a resting impulse's).
 void prepare_contact(Manifold& m, const BodyArrays& bodies, double dt, double collision_threshold);
 
-/// Applies `impulse` (on b; its opposite on a) at the contact point of lever arms ra, rb. A fixed or prescribed
-/// body (inv_mass = inv_inertia = 0) keeps its given velocity and is not written: the islands
-/// that share it are solved on several threads.
+/// Applies `impulse` (on b; its opposite on a) at the contact point of lever arms ra, rb. A
+/// fixed or prescribed body (inv_mass = inv_inertia = 0) keeps its given velocity and is not
+/// written: the islands that share it are solved on several threads.
 inline void apply_impulse(BodyArrays& s, int a, int b, Vec2 ra, Vec2 rb, Vec2 impulse) {
   if (s.inv_mass[a] != 0.0) {
     s.velocity[a] -= s.inv_mass[a] * impulse;
@@ -105,10 +105,10 @@ struct SweepLimits {
 
 /// Gauss-Seidel sweeps until the largest impulse change is below tolerance times the largest
 /// impulse, or the limits' sweeps are spent. With `warm_start`, each point's accumulated impulse
-/// is applied first (as apply_accumulated_impulses with +1, in the same order); with `accelerate`, each sweep but the
-/// last is followed by the nonsmooth nonlinear conjugate gradient step (see contact_solver.cpp).
-/// The manifolds' impulses are read at the start and written back at the end. Returns the
-/// number of sweeps made.
+/// is applied first (as apply_accumulated_impulses with +1, in the same order); with
+/// `accelerate`, each sweep but the last is followed by the nonsmooth nonlinear conjugate
+/// gradient step (see contact_solver.cpp). The manifolds' impulses are read at the start and
+/// written back at the end. Returns the number of sweeps made.
 struct SweepOptions {
   bool warm_start = false;
   bool accelerate = false;
