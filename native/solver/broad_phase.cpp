@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "parallel/thread_pool.hpp"
+#include "solver/headroom.hpp"
 
 namespace floedem {
 
@@ -96,7 +97,7 @@ void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::in
     Level& lv = levels_[l];
     const std::int64_t cells = lv.nx * lv.ny;
     for (std::int64_t c = 0; c < cells; ++c) lv.cell_start[c + 1] += lv.cell_start[c];
-    lv.items.resize(static_cast<std::size_t>(lv.cell_start[cells]));
+    resize_with_headroom(lv.items, static_cast<std::size_t>(lv.cell_start[cells]));
   }
   for (int l = 0; l <= top; ++l) {
     Level& lv = levels_[l];

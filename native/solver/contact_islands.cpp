@@ -41,7 +41,7 @@ void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays
   // Islands numbered by their first manifold. A manifold between two bodies that cannot move
   // (never paired by the broad phase) would be an island of its own.
   const std::size_t nm = manifolds.size();
-  manifold_island_.resize(nm);
+  resize_with_headroom(manifold_island_, nm);
   std::int32_t islands = 0;
   for (std::size_t k = 0; k < nm; ++k) {
     const Manifold& m = manifolds[k];
@@ -63,7 +63,7 @@ void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays
   for (const std::int32_t i : manifold_island_) ++manifold_start_[i + 1];
   for (std::int32_t i = 0; i < islands; ++i) manifold_start_[i + 1] += manifold_start_[i];
   fill_.assign(manifold_start_.begin(), manifold_start_.end() - 1);
-  manifold_.resize(nm);
+  resize_with_headroom(manifold_, nm);
   for (std::size_t k = 0; k < nm; ++k) manifold_[fill_[manifold_island_[k]]++] = static_cast<std::int32_t>(k);
 
   // The bodies in contact, ascending: sorted where they are few (the towing case), read off
@@ -80,7 +80,7 @@ void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays
   for (const std::int32_t b : touched_) ++body_start_[root_island_[find(b)] + 1];
   for (std::int32_t i = 0; i < islands; ++i) body_start_[i + 1] += body_start_[i];
   fill_.assign(body_start_.begin(), body_start_.end() - 1);
-  body_.resize(touched_.size());
+  resize_with_headroom(body_, touched_.size());
   for (const std::int32_t b : touched_) body_[fill_[root_island_[find(b)]]++] = b;
 }
 

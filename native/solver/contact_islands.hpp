@@ -32,6 +32,11 @@ class ContactIslands {
   std::span<const std::int32_t> bodies(std::size_t i) const {
     return {body_.data() + body_start_[i], body_.data() + body_start_[i + 1]};
   }
+  /// Where island i's bodies start in the islands' list of all (the bodies' ranges tile
+  /// [0, moving bodies in contact), as the manifolds' do).
+  std::size_t body_offset(std::size_t i) const { return static_cast<std::size_t>(body_start_[i]); }
+  /// Moving bodies in any manifold.
+  std::size_t body_count() const { return body_.size(); }
   /// The island that holds manifold k's moving bodies.
   std::int32_t island_of_manifold(std::size_t k) const { return manifold_island_[k]; }
 

@@ -14,4 +14,14 @@ void reserve_with_headroom(std::vector<T>& v, std::size_t n) {
   if (v.capacity() < n) v.reserve(n + n / 2);
 }
 
+/// Resizes v to n, with room for half as many again when it grows past what it holds.
+/// vector::resize past the capacity allocates size + max(size, n - size): after a list has
+/// shrunk (fewer contacts this step), that is barely more than n, so a size that goes down and
+/// up around its largest would allocate each time it sets a new largest.
+template <class T>
+void resize_with_headroom(std::vector<T>& v, std::size_t n) {
+  reserve_with_headroom(v, n);
+  v.resize(n);
+}
+
 }  // namespace floedem

@@ -124,12 +124,15 @@ class NativeEngine final : public Engine {
   /// What one block of islands works in, on whichever thread takes it (no allocation per step
   /// once sized), and what it reports back.
   struct IslandWork {
-    std::vector<Vec2> velocity;     // an island's bodies' velocities before its solve (cold restart)
-    std::vector<double> angular_velocity;
     int longest = 0;        // most sweeps an island of the block took
     int cold_restarts = 0;  // islands of the block solved again from zero
   };
   std::vector<IslandWork> island_work_;  // per block of islands
+  // The islands' bodies' velocities before their solves (a cold restart puts them back), each
+  // island in its slice (its bodies' place in islands_): one list for all, grown with headroom,
+  // so a pile that keeps growing (the towing case) does not allocate per block of islands.
+  std::vector<Vec2> island_velocity_;
+  std::vector<double> island_angular_velocity_;
   SweepWork sweep_work_;  // the islands' sweeps, each in its slice (its manifolds' place in islands_)
   static constexpr std::size_t kIslandGrain = 8;  // islands per block
   static constexpr std::size_t kPairGrain = 512;  // pairs per block (narrow phase, contact list)
@@ -472,8 +475,8 @@ void NativeEngine::build_manifolds() {
   // Per pair, its slot at the last narrow phase (both lists sorted): its separation hint
   // carries over, and where both parts were kept in place with the same reaches, its manifold.
   const bool may_reuse = any_kept_ && !previous_pairs_.empty();
-  if (may_reuse) reuse_.resize(pairs_.size());
-  narrow_hint_.resize(pairs_.size());
+  if (may_reuse) resize_with_headroom(reuse_, pairs_.size());
+  resize_with_headroom(narrow_hint_, pairs_.size());
   auto same_reach = [&](std::int32_t part) {
     return same_bits(part_reach_[part], previous_reach_[part]);
   };
@@ -528,7 +531,7 @@ void NativeEngine::build_manifolds() {
   // narrow phase's blocks), its first slot is the count of contacts in the blocks before it.
   for (std::size_t b = 0; b < blocks; ++b) block_contacts_[b + 1] += block_contacts_[b];
   const std::size_t contacts = block_contacts_[blocks];
-  if (manifolds_.size() < contacts) manifolds_.resize(contacts);
+  if (manifolds_.size() < contacts) resize_with_headroom(manifolds_, contacts);
   // Blocks on the pool's threads again: each manifold is written from its own slot, its
   // impulses carried over from last step's list (both lists are sorted by (part_a, part_b):
   // a merge from where the block's first pair would be) and classified, a function of the
@@ -592,8 +595,12 @@ void NativeEngine::solve_contacts() {
   // depend on the thread count.
   const std::size_t n = islands_.size();
   const std::size_t blocks = std::max<std::size_t>(1, (n + kIslandGrain - 1) / kIslandGrain);
-  if (island_work_.size() < blocks) island_work_.resize(blocks);
+  if (island_work_.size() < blocks) island_work_.resize(blocks + blocks / 2);
   sweep_work_.reserve(manifolds_.size(), settings_.accelerate);
+  if (checked) {
+    resize_with_headroom(island_velocity_, islands_.body_count());
+    resize_with_headroom(island_angular_velocity_, islands_.body_count());
+  }
   for (IslandWork& w : island_work_) w.longest = w.cold_restarts = 0;
   thread_pool().for_blocks(n, kIslandGrain, [&](std::size_t begin, std::size_t end) {
     IslandWork& w = island_work_[begin / kIslandGrain];
@@ -627,11 +634,10 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
   double before = 0.0;
   if (checked) {
     before = kinetic_energy_of(bodies);
-    work.velocity.clear();
-    work.angular_velocity.clear();
-    for (const std::int32_t b : bodies) {
-      work.velocity.push_back(bodies_.velocity[b]);
-      work.angular_velocity.push_back(bodies_.angular_velocity[b]);
+    const std::size_t at = islands_.body_offset(island);
+    for (std::size_t x = 0; x < bodies.size(); ++x) {
+      island_velocity_[at + x] = bodies_.velocity[bodies[x]];
+      island_angular_velocity_[at + x] = bodies_.angular_velocity[bodies[x]];
     }
   }
   const SweepSpace space = sweep_work_.slice(islands_.manifold_offset(island), manifolds.size());
@@ -642,9 +648,10 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
   if (has_prescribed_)
     for (const std::int32_t k : manifolds) pushed += kinematic_work(manifolds_[k]);
   if (kinetic_energy_of(bodies) - 2.0 * pushed <= before) return sweeps;
+  const std::size_t at = islands_.body_offset(island);
   for (std::size_t x = 0; x < bodies.size(); ++x) {
-    bodies_.velocity[bodies[x]] = work.velocity[x];
-    bodies_.angular_velocity[bodies[x]] = work.angular_velocity[x];
+    bodies_.velocity[bodies[x]] = island_velocity_[at + x];
+    bodies_.angular_velocity[bodies[x]] = island_angular_velocity_[at + x];
   }
   for (const std::int32_t k : manifolds) {
     Manifold& m = manifolds_[k];

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "parallel/thread_pool.hpp"
+#include "solver/headroom.hpp"
 
 namespace floedem {
 
@@ -121,7 +122,7 @@ void PairCache::refresh(std::span<const std::int32_t> body, std::span<const std:
   kept_.clear();
   for (const PartPair& p : candidates_)
     if (!moved_[p.a] && !moved_[p.b]) kept_.push_back(p);
-  candidates_.resize(kept_.size() + fresh_.size());
+  resize_with_headroom(candidates_, kept_.size() + fresh_.size());
   std::merge(kept_.begin(), kept_.end(), fresh_.begin(), fresh_.end(), candidates_.begin());
   for (const std::int32_t k : moved_list_) moved_[k] = 0;
 }
