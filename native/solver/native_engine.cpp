@@ -121,8 +121,7 @@ class NativeEngine final : public Engine {
   std::int64_t direct_solves_ = 0;    // steps whose islands were solved directly
   std::int64_t direct_reverted_ = 0;  // ... and then given back (they would have made energy)
   ContactIslands islands_;
-  /// What one block of islands works in, on whichever thread takes it (no allocation per step
-  /// once sized), and what it reports back.
+  /// What one block of islands reports back (its scratch lives in the step-wide lists below).
   struct IslandWork {
     int longest = 0;        // most sweeps an island of the block took
     int cold_restarts = 0;  // islands of the block solved again from zero
