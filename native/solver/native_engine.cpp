@@ -630,10 +630,10 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
   // contacts_gain_energy).
   const std::span<const std::int32_t> manifolds = islands_.manifolds(island);
   const std::span<const std::int32_t> bodies = islands_.bodies(island);
+  const std::size_t at = islands_.body_offset(island);  // its bodies' slice of the saved velocities
   double before = 0.0;
   if (checked) {
     before = kinetic_energy_of(bodies);
-    const std::size_t at = islands_.body_offset(island);
     for (std::size_t x = 0; x < bodies.size(); ++x) {
       island_velocity_[at + x] = bodies_.velocity[bodies[x]];
       island_angular_velocity_[at + x] = bodies_.angular_velocity[bodies[x]];
@@ -647,7 +647,6 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
   if (has_prescribed_)
     for (const std::int32_t k : manifolds) pushed += kinematic_work(manifolds_[k]);
   if (kinetic_energy_of(bodies) - 2.0 * pushed <= before) return sweeps;
-  const std::size_t at = islands_.body_offset(island);
   for (std::size_t x = 0; x < bodies.size(); ++x) {
     bodies_.velocity[bodies[x]] = island_velocity_[at + x];
     bodies_.angular_velocity[bodies[x]] = island_angular_velocity_[at + x];

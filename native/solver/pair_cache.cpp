@@ -76,7 +76,7 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
   // in all with this).
   std::size_t total = 0;
   for (std::size_t b = 0; b < blocks; ++b) total += overlapping_[b].size();
-  if (out.capacity() < total) out.reserve(total + total / 2);
+  reserve_with_headroom(out, total);
   out.clear();
   for (std::size_t b = 0; b < blocks; ++b) out.insert(out.end(), overlapping_[b].begin(), overlapping_[b].end());
 }
