@@ -14,14 +14,6 @@ namespace {
 // a step (broad phase, island grouping: 0.05-0.3 ms on the 16k field), far shorter than a step.
 constexpr auto kSpin = std::chrono::microseconds(200);
 
-inline void relax() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#elif defined(__aarch64__)
-  asm volatile("yield");
-#endif
-}
-
 /// True as soon as ready() is, false if it is not within kSpin.
 template <class Ready>
 bool watch(Ready ready) {
@@ -29,7 +21,7 @@ bool watch(Ready ready) {
   for (;;) {
     for (int k = 0; k < 64; ++k) {
       if (ready()) return true;
-      relax();
+      cpu_relax();
     }
     if (std::chrono::steady_clock::now() >= until) return ready();
   }

@@ -20,4 +20,14 @@ inline unsigned worker_threads() {
   return hw == 0 ? 1 : hw;
 }
 
+/// A spin-wait's pause: tells the core a loop is waiting on another thread (frees the pipeline
+/// for a sibling hyperthread, saves power).
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
 }  // namespace floedem

@@ -5,6 +5,9 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "solver/sweep_pipeline.hpp"
+#include "solver/sweep_row.hpp"
+
 // Contact constraint, per point, between bodies a and b (normal n from a to b, tangent t = k x n):
 //
 //   relative velocity   u = (v_b + w_b k x r_b) - (v_a + w_a k x r_a),  u_n = u.n, u_t = u.t
@@ -28,40 +31,6 @@
 // solution (Jean's NSCD / Catto's sequential impulses with a block-exact local solver).
 
 namespace floedem {
-
-namespace {
-// Inlined into the sweep (called once per point per sweep; inlined, the towing case's sweeps
-// take about 3 % fewer instructions); the same arithmetic as a call, so the same impulses to the bit.
-[[gnu::always_inline]] inline LocalImpulse local_impulse(double ufn, double uft, double target, double mu, double wnn,
-                                                        double wnt, double wtt) {
-  const double need = target - ufn;  // normal velocity change wanted
-  if (need <= 0.0) return {};        // separating (or already fast enough): no impulse
-  if (mu <= 0.0) return {need / wnn, 0.0};
-
-  // Stick: u_n+ = u*, u_t+ = 0  =>  W (P_n, P_t) = (need, -u_t).
-  const double det = wnn * wtt - wnt * wnt;
-  const double pn_stick = (wtt * need + wnt * uft) / det;
-  const double pt_stick = (-wnn * uft - wnt * need) / det;
-  if (pn_stick >= 0.0 && std::abs(pt_stick) <= mu * pn_stick) return {pn_stick, pt_stick};
-
-  // Slide with final slip direction s (= sign u_t+): P_t = -s mu P_n, and
-  // (W_nn - s mu W_nt) P_n = need; consistent if P_n >= 0 and s u_t+ >= 0.
-  const double first = pt_stick > 0.0 ? -1.0 : 1.0;  // friction saturates on the side stick wanted
-  const double scale = std::abs(uft) + std::abs(need);
-  for (const double s : {first, -first}) {
-    const double denom = wnn - s * mu * wnt;
-    if (denom <= 0.0) continue;
-    const double pn = need / denom;
-    const double ut = uft + (wnt - s * mu * wtt) * pn;
-    if (s * ut >= -1e-14 * scale) return {pn, -s * mu * pn};
-  }
-  // No consistent case (Painleve-like configurations with strong coupling): the frictionless
-  // normal impulse with friction clamped to the cone.
-  const double pn = need / wnn;
-  const double pt = std::clamp(-(uft + wnt * pn) / wtt, -mu * pn, mu * pn);
-  return {pn, pt};
-}
-}  // namespace
 
 LocalImpulse solve_single_contact(double ufn, double uft, double target, double mu, double wnn, double wnt,
                                   double wtt) {
@@ -197,7 +166,7 @@ void scatter_rows(const Rows& manifolds, std::span<const SweepRow> rows) {
 }
 
 int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limits, SweepSpace work,
-               bool accelerate) {
+               bool accelerate, SweepPipeline* pipeline) {
   if (accelerate) {
     work.change = work.change.first(2 * rows.size());
     work.direction = work.direction.first(2 * rows.size());
@@ -208,6 +177,15 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
   double previous_size = 0.0;  // |r_k|^2; 0 before the first sweep
   int max_iterations = limits.iterations;
   int sweep = 0;
+  if (!accelerate && pipeline != nullptr && limits.iterations > 1 && SweepPipeline::parts_for(rows.size()) > 1) {
+    // The ordinary sweeps on several threads; then, as the loop below after its sweep
+    // `iterations`, the look at what is left closing, and any extra sweeps here.
+    const SweepPipeline::Result made = pipeline->run(rows, s, limits.iterations, limits.tolerance);
+    sweep = made.sweeps;
+    if (made.converged || limits.extra_iterations <= 0) return sweep;
+    if (largest_shortfall_of(rows, s) <= limits.closing_speed) return sweep;
+    max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
+  }
   while (sweep < max_iterations) {
     ++sweep;
     double largest_change = 0.0;
@@ -215,20 +193,10 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
     double size = 0.0;  // |r_{k+1}|^2
     for (std::size_t i = 0; i < rows.size(); ++i) {
       SweepRow& p = rows[i];
-      const Vec2 n = p.normal;
-      const Vec2 t = perp(n);
-      const Vec2 u = relative_velocity(s, p.body_a, p.body_b, p.ra, p.rb);
-      const double pn0 = p.normal_impulse, pt0 = p.tangent_impulse;
-      // Velocity without this point's own impulse.
-      const double ufn = dot(u, n) - (p.wnn * pn0 + p.wnt * pt0);
-      const double uft = dot(u, t) - (p.wnt * pn0 + p.wtt * pt0);
-      const LocalImpulse r = local_impulse(ufn, uft, p.target_velocity, p.friction, p.wnn, p.wnt, p.wtt);
-      const double dpn = r.normal - pn0, dpt = r.tangent - pt0;
-      if (dpn != 0.0 || dpt != 0.0) apply_row_impulse(s, p, dpn * n + dpt * t);
-      p.normal_impulse = r.normal;
-      p.tangent_impulse = r.tangent;
+      const RowChange d = sweep_row(p, s);
+      const double dpn = d.normal, dpt = d.tangent;
       largest_change = std::max(largest_change, std::abs(dpn) + std::abs(dpt));
-      largest_impulse = std::max(largest_impulse, r.normal + std::abs(r.tangent));
+      largest_impulse = std::max(largest_impulse, p.normal_impulse + std::abs(p.tangent_impulse));
       if (accelerate) {
         work.change[2 * i] = dpn;
         work.change[2 * i + 1] = dpt;
@@ -276,7 +244,7 @@ int solve_rows(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, 
   if (space.rows.size() < 2 * manifolds.size() || (options.accelerate && space.change.size() < 4 * manifolds.size()))
     throw std::logic_error("solve_velocities: the sweep space holds fewer manifolds than the solve");
   const std::span<SweepRow> rows = space.rows.first(gather_rows(manifolds, s, options.warm_start, space.rows));
-  const int sweeps = run_sweeps(rows, s, limits, space, options.accelerate);
+  const int sweeps = run_sweeps(rows, s, limits, space, options.accelerate, options.pipeline);
   scatter_rows(manifolds, rows);
   return sweeps;
 }

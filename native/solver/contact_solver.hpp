@@ -103,6 +103,8 @@ struct SweepLimits {
   double closing_speed = 0.0;  ///< ... a point approaches faster than its target by more than this (m/s)
 };
 
+class SweepPipeline;
+
 /// Gauss-Seidel sweeps until the largest impulse change is below tolerance times the largest
 /// impulse, or the limits' sweeps are spent. With `warm_start`, each point's accumulated impulse
 /// is applied first (as apply_accumulated_impulses with +1, in the same order); with
@@ -112,6 +114,9 @@ struct SweepLimits {
 struct SweepOptions {
   bool warm_start = false;
   bool accelerate = false;
+  /// Plain sweeps (without `accelerate`) of enough rows on the pool's threads, the same to the
+  /// bit (sweep_pipeline.hpp). Not from inside a loop of the pool.
+  SweepPipeline* pipeline = nullptr;
 };
 /// `space` must hold manifolds.size() manifolds (and their accelerated arrays with `accelerate`).
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, const SweepLimits& limits, SweepSpace space,

@@ -24,6 +24,7 @@
 #include "solver/island_solve.hpp"
 #include "solver/narrow_phase.hpp"
 #include "solver/part_set.hpp"
+#include "solver/sweep_pipeline.hpp"
 #include "solver/native_settings.hpp"
 #include "parallel/thread_pool.hpp"
 
@@ -63,7 +64,7 @@ class NativeEngine final : public Engine {
                      SeparationHint* hint = nullptr) const;
   void solve_contacts();
   struct IslandWork;
-  int solve_island(std::size_t island, bool checked, IslandWork& work);
+  int solve_island(std::size_t island, bool checked, IslandWork& work, SweepPipeline* pipeline);
   void solve_islands_directly(double energy_before);
   bool contacts_gain_energy(double energy_before) const;
   double contact_kinetic_energy() const;
@@ -133,6 +134,7 @@ class NativeEngine final : public Engine {
   std::vector<Vec2> island_velocity_;
   std::vector<double> island_angular_velocity_;
   SweepWork sweep_work_;  // the islands' sweeps, each in its slice (its manifolds' place in islands_)
+  SweepPipeline sweep_pipeline_;  // the plain sweeps of the largest islands, on every thread
   static constexpr std::size_t kIslandGrain = 8;  // islands per block
   static constexpr std::size_t kPairGrain = 512;  // pairs per block (narrow phase, contact list)
   std::vector<Vec2> saved_velocity_;
@@ -601,10 +603,24 @@ void NativeEngine::solve_contacts() {
     resize_with_headroom(island_angular_velocity_, islands_.body_count());
   }
   for (IslandWork& w : island_work_) w.longest = w.cold_restarts = 0;
+  // An island with rows enough for several threads' worth (the packed field's one large island)
+  // is left out of the blocks and solved after them on every thread at once, its plain sweeps
+  // pipelined (sweep_pipeline.hpp): on two threads, the rest of the islands and it would
+  // otherwise wait for the one thread that has it.
+  const bool pipelined = !settings_.accelerate && thread_pool().size() > 1;
+  auto large = [&](std::size_t i) {
+    return pipelined && SweepPipeline::parts_for(2 * islands_.manifolds(i).size()) > 1;
+  };
   thread_pool().for_blocks(n, kIslandGrain, [&](std::size_t begin, std::size_t end) {
     IslandWork& w = island_work_[begin / kIslandGrain];
-    for (std::size_t i = begin; i < end; ++i) w.longest = std::max(w.longest, solve_island(i, checked, w));
+    for (std::size_t i = begin; i < end; ++i)
+      if (!large(i)) w.longest = std::max(w.longest, solve_island(i, checked, w, nullptr));
   });
+  for (std::size_t i = 0; pipelined && i < n; ++i)
+    if (large(i)) {
+      IslandWork& w = island_work_[i / kIslandGrain];
+      w.longest = std::max(w.longest, solve_island(i, checked, w, &sweep_pipeline_));
+    }
   int longest = 0;
   for (const IslandWork& w : island_work_) {
     longest = std::max(longest, w.longest);
@@ -619,7 +635,7 @@ void NativeEngine::solve_contacts() {
   if (heavy_light_ && longest >= settings_.velocity_iterations) solve_islands_directly(before);
 }
 
-int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& work) {
+int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& work, SweepPipeline* pipeline) {
   // Gauss-Seidel from zero impulses cannot raise the kinetic energy: with a non-positive target
   // each local update moves the velocity to the constraint set along M^-1 J^T, which never
   // raises 1/2 v'Mv (a projection in the metric of M). Warm starting (last step's impulses
@@ -641,7 +657,7 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
   }
   const SweepSpace space = sweep_work_.slice(islands_.manifold_offset(island), manifolds.size());
   int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,
-                                {.warm_start = settings_.warm_start, .accelerate = settings_.accelerate});
+                                {.warm_start = settings_.warm_start, .accelerate = settings_.accelerate, .pipeline = pipeline});
   if (!checked) return sweeps;
   double pushed = 0.0;  // the work of towed bodies on this island's floes (contacts_gain_energy)
   if (has_prescribed_)
@@ -655,7 +671,8 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
     Manifold& m = manifolds_[k];
     for (int j = 0; j < m.point_count; ++j) m.points[j].normal_impulse = m.points[j].tangent_impulse = 0.0;
   }
-  sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space);  // plain sweeps: no energy made
+  sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,  // plain sweeps: no energy made
+                             {.pipeline = pipeline});
   ++work.cold_restarts;
   return sweeps;
 }

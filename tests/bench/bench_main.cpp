@@ -17,6 +17,9 @@
 #include "solver/narrow_phase.hpp"
 #include "solver/native_settings.hpp"
 #include "solver/part_set.hpp"
+#include "solver/sweep_pipeline.hpp"
+#include "parallel/thread_pool.hpp"
+#include "parallel/threads.hpp"
 
 using namespace floedem;
 
@@ -249,10 +252,10 @@ const PackedField& packed_field() {
   return field;
 }
 
-/// The contact sweeps of one step on the packed field: the warm start and 10 plain
-/// Gauss-Seidel sweeps (the speed benchmark's settings), from the same impulses and
-/// velocities each time. ns_per_point_sweep: the cost of one point's local solve.
-void BM_ContactSweeps(benchmark::State& state) {
+/// One step's contact sweeps on the packed field, timed: the warm start and 10 plain
+/// Gauss-Seidel sweeps (the speed benchmark's settings), from the same impulses and velocities
+/// each time; pipelined over the pool's threads with `pipeline`. Returns the contact points.
+std::size_t time_contact_sweeps(benchmark::State& state, SweepPipeline* pipeline) {
   const PackedField& field = packed_field();
   std::vector<Manifold> manifolds = field.manifolds;
   BodyArrays bodies = field.bodies;
@@ -266,7 +269,8 @@ void BM_ContactSweeps(benchmark::State& state) {
     bodies.velocity = field.bodies.velocity;
     bodies.angular_velocity = field.bodies.angular_velocity;
     state.ResumeTiming();
-    sweeps = solve_velocities(manifolds, bodies, field.limits, work.space(manifolds.size(), false), {.warm_start = true});
+    sweeps = solve_velocities(manifolds, bodies, field.limits, work.space(manifolds.size(), false),
+                              {.warm_start = true, .pipeline = pipeline});
     benchmark::DoNotOptimize(bodies.velocity.data());
   }
   state.counters["manifolds"] = static_cast<double>(manifolds.size());
@@ -274,8 +278,25 @@ void BM_ContactSweeps(benchmark::State& state) {
   state.counters["sweeps"] = sweeps;
   state.counters["ns_per_point_sweep"] = benchmark::Counter(static_cast<double>(points) * sweeps,
                                                             benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  return points;
 }
+
+/// The sweeps on one thread. ns_per_point_sweep: the cost of one point's local solve.
+void BM_ContactSweeps(benchmark::State& state) { time_contact_sweeps(state, nullptr); }
 BENCHMARK(BM_ContactSweeps)->Unit(benchmark::kMicrosecond);
+
+/// The same sweeps pipelined over a pool of state.range(0) threads (sweep_pipeline.hpp): the
+/// same impulses to the bit, in wall time (on a machine with fewer cores than threads, the
+/// threads take turns). parts: the threads the pipeline used. The pool is set back to
+/// FLOEDEM_THREADS after.
+void BM_ContactSweepsPipelined(benchmark::State& state) {
+  set_thread_pool_size(static_cast<unsigned>(state.range(0)));
+  SweepPipeline pipeline;
+  const std::size_t points = time_contact_sweeps(state, &pipeline);
+  state.counters["parts"] = SweepPipeline::parts_for(points);
+  set_thread_pool_size(worker_threads());
+}
+BENCHMARK(BM_ContactSweepsPipelined)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 /// The narrow phase of one step on the packed field: every pair of the broad phase collided
 /// (no reuse of last step's manifolds, no separation hints). ns_per_pair: one pair's test.

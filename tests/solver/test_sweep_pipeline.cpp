@@ -1,0 +1,228 @@
+// The pipelined sweeps (native/solver/sweep_pipeline.cpp) against the serial ones: the same
+// impulses and velocities to the bit, on several thread counts, whether the sweeps run to their
+// limit, stop on the tolerance (a sweep some threads went on into is put back) or go on into
+// the extra sweeps; and the native engine that routes a packed field's large island to it.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <span>
+
+#include "parallel/thread_pool.hpp"
+#include "parallel/threads.hpp"
+#include "run/stepper.hpp"
+#include "scenario/scenario.hpp"
+#include "solver/contact_solver.hpp"
+#include "solver/sweep_pipeline.hpp"
+
+using namespace floedem;
+
+namespace {
+
+// A pressed pack: columns x rows of unit-density boxes of side 8 to 12 m on a grid, each
+// touching its right and upper neighbour at two points, the left column against a fixed wall
+// (body 0). Random velocities (a few pressed together, most drifting), so that the sweeps have
+// collisions, resting contacts, sticking and sliding friction to solve.
+struct Pack {
+  BodyArrays bodies;
+  std::vector<Manifold> manifolds;
+};
+
+Pack pack(int columns, int rows, std::uint32_t seed, bool shuffled) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Pack p;
+  const std::size_t n = static_cast<std::size_t>(columns * rows) + 1;
+  p.bodies.resize(n);
+  p.bodies.rotation.assign(n, Rot::from_angle(0.0));
+  p.bodies.inv_mass.assign(n, 0.0);
+  p.bodies.inv_inertia.assign(n, 0.0);
+  auto id = [&](int c, int r) { return 1 + r * columns + c; };
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < columns; ++c) {
+      const auto b = static_cast<std::size_t>(id(c, r));
+      const double side = 8.0 + 4.0 * u(rng), mass = 900.0 * side * side;
+      p.bodies.position[b] = {10.0 * c + 5.0, 10.0 * r + 5.0};
+      p.bodies.velocity[b] = {-0.5 * u(rng), 0.2 * (u(rng) - 0.5)};
+      p.bodies.angular_velocity[b] = 0.01 * (u(rng) - 0.5);
+      p.bodies.inv_mass[b] = 1.0 / mass;
+      p.bodies.inv_inertia[b] = 12.0 / (mass * 2.0 * side * side);
+    }
+  auto join = [&](std::int32_t a, std::int32_t b, Vec2 normal, Vec2 at) {
+    Manifold m;
+    m.body_a = a;
+    m.body_b = b;
+    m.part_a = a;
+    m.part_b = b;
+    m.normal = normal;
+    m.friction = 0.3;
+    m.restitution = 0.1;
+    m.point_count = 2;
+    const Vec2 along = perp(normal);
+    for (int k = 0; k < 2; ++k) {
+      m.points[k].point = at + (k == 0 ? 3.0 : -3.0) * along;
+      m.points[k].separation = -0.01 * u(rng);
+      m.points[k].id = static_cast<std::uint32_t>(k);
+    }
+    prepare_contact(m, p.bodies, 0.05, 0.01);
+    for (ManifoldPoint& q : m.points) q.normal_impulse = u(rng) < 0.5 ? 1e3 * u(rng) : 0.0;  // a warm start
+    p.manifolds.push_back(m);
+  };
+  for (int r = 0; r < rows; ++r) {
+    join(0, id(0, r), {1.0, 0.0}, {0.0, 10.0 * r + 5.0});
+    for (int c = 0; c < columns; ++c) {
+      if (c + 1 < columns) join(id(c, r), id(c + 1, r), {1.0, 0.0}, {10.0 * c + 10.0, 10.0 * r + 5.0});
+      if (r + 1 < rows) join(id(c, r), id(c, r + 1), {0.0, 1.0}, {10.0 * c + 5.0, 10.0 * r + 10.0});
+    }
+  }
+  // The engine's order is by pair (the field generator numbers floes about in space); shuffled,
+  // each part's rows wait on the other's all through the sweep.
+  if (shuffled) std::shuffle(p.manifolds.begin(), p.manifolds.end(), rng);
+  return p;
+}
+
+bool same_bits(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec2)) == 0;
+}
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+bool same_impulses(const std::vector<Manifold>& a, const std::vector<Manifold>& b) {
+  for (std::size_t k = 0; k < a.size(); ++k)
+    for (int j = 0; j < a[k].point_count; ++j)
+      if (std::memcmp(&a[k].points[j].normal_impulse, &b[k].points[j].normal_impulse, sizeof(double)) != 0 ||
+          std::memcmp(&a[k].points[j].tangent_impulse, &b[k].points[j].tangent_impulse, sizeof(double)) != 0)
+        return false;
+  return true;
+}
+
+struct Solved {
+  Pack state;
+  int sweeps = 0;
+};
+
+Solved solve(const Pack& start, const SweepLimits& limits, SweepPipeline* pipeline) {
+  Solved s{start, 0};
+  SweepWork work;
+  s.sweeps = solve_velocities(s.state.manifolds, s.state.bodies, limits, work.space(s.state.manifolds.size(), false),
+                              {.warm_start = true, .pipeline = pipeline});
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("sweep pipeline: the same impulses and velocities as the serial sweeps, to the bit", "[solver][threads]") {
+  const bool shuffled = GENERATE(false, true);
+  const Pack start = pack(60, 40, 7, shuffled);  // 4 700 manifolds, 9 400 rows
+  // Limits: (a) 30 sweeps, no tolerance: every sweep made; (b) a tolerance the sweeps meet part
+  // way (checked below on the serial run); (c) 5 sweeps and extra sweeps while a point closes.
+  const SweepLimits limits = GENERATE(SweepLimits{30, 0.0}, SweepLimits{400, 1e-2}, SweepLimits{5, 1e-10, 40, 1e-4});
+  const Solved serial = solve(start, limits, nullptr);
+  if (limits.tolerance > 1e-6) REQUIRE(serial.sweeps < limits.iterations);  // stopped on the tolerance
+  if (limits.extra_iterations > 0) REQUIRE(serial.sweeps > limits.iterations);
+
+  for (const unsigned threads : {2u, 3u, 4u}) {
+    set_thread_pool_size(threads);
+    INFO("threads " << threads << (shuffled ? ", shuffled" : ""));
+    REQUIRE(SweepPipeline::parts_for(2 * start.manifolds.size()) == threads);
+    SweepPipeline pipeline;
+    for (int repeat = 0; repeat < 3; ++repeat) {  // the pipeline's lists reused, as from step to step
+      const Solved piped = solve(start, limits, &pipeline);
+      CHECK(piped.sweeps == serial.sweeps);
+      CHECK(same_bits(piped.state.bodies.velocity, serial.state.bodies.velocity));
+      CHECK(same_bits(piped.state.bodies.angular_velocity, serial.state.bodies.angular_velocity));
+      CHECK(same_impulses(piped.state.manifolds, serial.state.manifolds));
+    }
+  }
+  set_thread_pool_size(worker_threads());
+}
+
+TEST_CASE("sweep pipeline: a sweep begun before the stop was known is put back", "[solver][threads]") {
+  // Whether a thread went on into the sweep after the one that met the tolerance depends on
+  // timing: over a range of tolerances (stopping at different sweeps), some do, and every
+  // result is the serial one's.
+  const Pack start = pack(60, 40, 11, false);
+  set_thread_pool_size(2);
+  SweepPipeline pipeline;
+  std::int64_t put_back = 0;
+  for (int k = 0; k < 40 && put_back < 3; ++k) {
+    const SweepLimits limits{400, 0.1 * std::pow(0.8, k)};
+    const Solved serial = solve(start, limits, nullptr);
+    const std::int64_t before = pipeline.sweeps_put_back();
+    const Solved piped = solve(start, limits, &pipeline);
+    put_back += pipeline.sweeps_put_back() - before;
+    INFO("tolerance " << limits.tolerance);
+    REQUIRE(piped.sweeps == serial.sweeps);
+    REQUIRE(same_bits(piped.state.bodies.velocity, serial.state.bodies.velocity));
+    REQUIRE(same_bits(piped.state.bodies.angular_velocity, serial.state.bodies.angular_velocity));
+    REQUIRE(same_impulses(piped.state.manifolds, serial.state.manifolds));
+  }
+  set_thread_pool_size(worker_threads());
+  CHECK(put_back > 0);
+}
+
+TEST_CASE("sweep pipeline: too few rows for a second thread", "[solver][threads]") {
+  set_thread_pool_size(2);
+  CHECK(SweepPipeline::parts_for(100) == 1);
+  CHECK(SweepPipeline::parts_for(5000) == 2);
+  set_thread_pool_size(1);
+  CHECK(SweepPipeline::parts_for(100000) == 1);
+  set_thread_pool_size(worker_threads());
+}
+
+namespace {
+
+// Contact points of the largest island at the engine's last step: groups of moving bodies
+// joined by contacts (a fixed body joins nothing, as in the engine's islands). Each point is
+// at least one sweep row, so this bounds the island's rows from below.
+std::size_t largest_island_points(const Scene& scene, std::span<const ContactRecord> contacts) {
+  std::vector<std::size_t> root(scene.bodies.size());
+  for (std::size_t i = 0; i < root.size(); ++i) root[i] = i;
+  auto find = [&](std::size_t i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  auto moving = [&](std::int32_t b) { return !scene.bodies[static_cast<std::size_t>(b)].fixed; };
+  for (const ContactRecord& c : contacts)
+    if (moving(c.body_a) && moving(c.body_b))
+      root[find(static_cast<std::size_t>(c.body_a))] = find(static_cast<std::size_t>(c.body_b));
+  std::vector<std::size_t> points(root.size(), 0);
+  std::size_t most = 0;
+  for (const ContactRecord& c : contacts) {
+    const std::int32_t b = moving(c.body_a) ? c.body_a : c.body_b;
+    most = std::max(most, ++points[find(static_cast<std::size_t>(b))]);
+  }
+  return most;
+}
+
+}  // namespace
+
+TEST_CASE("sweep pipeline: the native engine on a packed field gives the same state on 1 and 2 threads",
+          "[solver][threads]") {
+  // The 4k field benchmark driven onto its wall at twice its current for 45 s: by then many
+  // floes touch and the largest island has rows enough for two parts, so on two threads the
+  // engine solves it pipelined (native_engine.cpp, solve_contacts) while the small islands go to
+  // the islands' blocks. Every body's velocity and position, bit for bit.
+  const Scene scene = load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_4k.toml",
+                                    {"environment.current=[1.0, 0.0]"});
+  constexpr int kSteps = 900;  // 45 s at dt 0.05 s
+  BodyStates states[2];
+  for (const unsigned threads : {1u, 2u}) {
+    set_thread_pool_size(threads);
+    Stepper stepper(scene, "native");
+    for (int k = 0; k < kSteps; ++k) stepper.step();
+    if (threads == 2) {
+      const std::size_t points = largest_island_points(scene, stepper.contacts());
+      INFO("largest island: " << points << " contact points");
+      REQUIRE(SweepPipeline::parts_for(points) == 2);  // it was pipelined
+    }
+    states[threads - 1] = stepper.state();
+  }
+  set_thread_pool_size(worker_threads());
+  CHECK(same_bits(states[0].velocity, states[1].velocity));
+  CHECK(same_bits(states[0].angular_velocity, states[1].angular_velocity));
+  CHECK(same_bits(states[0].position, states[1].position));
+  CHECK(same_bits(states[0].angle, states[1].angle));
+}
