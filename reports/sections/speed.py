@@ -130,9 +130,11 @@ def write(ctx):
         one = scaling[0][1]
         md += [f"Threads (native, `{next(r for t, r in every.items() if t.startswith('speed_threads_'))['scenario']}`, "
                "FLOEDEM_THREADS; the output is the same to the bit on any number): the per-body and per-pair loops "
-               "(drag, forcing, placing, narrow phase, integration) and the contact solve's islands run on the pool; "
-               "one island is one Gauss-Seidel solve and the position projection is serial, so the speed-up is "
-               "bounded by the largest island (a field packed on a wall is nearly one) and the projection.", "",
+               "(drag, forcing, placing, narrow phase, integration) and the contact solve's islands run on the pool, "
+               "and the plain sweeps of an island too large for one thread (a field packed on a wall is nearly one "
+               "island) are pipelined over every thread (`native/solver/sweep_pipeline.cpp`). What stays on one "
+               "thread bounds the speed-up: the position projection, the island grouping, the large island's warm "
+               "start and the pipeline's plan.", "",
                "| threads | ms per step | speed-up |", "|---|---|---|"]
         md += [f"| {t} | {ms:.2f} | {one / ms:.2f} |" for t, ms in scaling]
         md.append("")
