@@ -137,8 +137,35 @@ def write(ctx):
                "start and the pipeline's plan.", "",
                "| threads | ms per step | speed-up |", "|---|---|---|"]
         md += [f"| {t} | {ms:.2f} | {one / ms:.2f} |" for t, ms in scaling]
-        md.append("")
+        md += ["", "![ms per step and speed-up against threads](fig/speed_threads.png)", ""]
+        threads_figure(ctx, scaling, every)
     return md, []
+
+
+def threads_figure(ctx, scaling, every):
+    """Native's ms per step and speed-up against the thread count (the scaling runs)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    threads = [t for t, _ in scaling]
+    ms = [m for _, m in scaling]
+    row = next(r for t, r in every.items() if t.startswith("speed_threads_"))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(9, 3.6))
+    ax.plot(threads, ms, "o-")
+    ax.set_xlabel("threads (FLOEDEM_THREADS)")
+    ax.set_ylabel("ms per step (median)")
+    ax.set_ylim(bottom=0)
+    bx.plot(threads, [ms[0] / m for m in ms], "o-", label="measured")
+    bx.plot(threads, threads, "k:", lw=0.8, label="ideal")
+    bx.set_xlabel("threads (FLOEDEM_THREADS)")
+    bx.set_ylabel("speed-up against 1 thread")
+    bx.legend()
+    for a in (ax, bx):
+        a.set_xticks(threads)
+    fig.suptitle(f"native, {row['scenario']} packed on its wall, {row['cpu']} ({row['host']})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(os.path.join(ctx.fig, "speed_threads.png"), dpi=110)
+    plt.close(fig)
 
 
 def targets(rows):
