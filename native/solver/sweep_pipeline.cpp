@@ -80,9 +80,12 @@ void SweepPipeline::plan(std::span<const SweepRow> rows, const BodyArrays& s, un
   const double scale = extent > 0.0 ? (kBins - 1) / extent : 0.0;
   auto bin_of = [&](std::size_t i) {
     const double key = key_[2 * i + static_cast<std::size_t>(axis)];
-    // (a row of no moving body: part 0; clamped, so that no key outside the extent, nor a NaN,
-    // makes a bin that is not there)
-    return key > none ? static_cast<std::size_t>(std::clamp((key - low) * scale, 0.0, double{kBins - 1})) : 0;
+    if (!(key > none)) return std::size_t{0};  // a row of no moving body (or a NaN key): part 0
+    // Clamped, so that no key makes a bin that is not there: not one beyond the extent, nor a
+    // NaN (inf * 0 where coordinates overflow the extent; std::clamp would pass it through, and
+    // its cast to an integer is undefined). The bins only place rows in parts: any is correct.
+    const double at = (key - low) * scale;
+    return at > 0.0 ? static_cast<std::size_t>(std::min(at, double{kBins - 1})) : std::size_t{0};
   };
   std::fill(std::begin(bin_part_), std::end(bin_part_), 0);
   for (std::size_t i = 0; i < r_count; ++i) ++bin_part_[bin_of(i)];

@@ -163,6 +163,26 @@ TEST_CASE("sweep pipeline: a sweep begun before the stop was known is put back",
   CHECK(put_back > 0);
 }
 
+TEST_CASE("sweep pipeline: bodies whose spread overflows a double are placed in parts all the same",
+          "[solver][threads]") {
+  // Two floes at -1e308 and 1e308 m: the island's extent is infinite, so the slabs' scale is 0
+  // and the far floe's place along it inf * 0 = NaN. Rows are placed in parts from their
+  // bodies' positions only (the sweeps read lever arms, not positions), so the sweeps are the
+  // serial ones' all the same; a NaN cast to a bin index read far outside the bins.
+  Pack start = pack(60, 40, 13, false);
+  start.bodies.position[1] = {-1e308, 0.0};
+  start.bodies.position[start.bodies.position.size() - 1] = {1e308, 0.0};
+  const SweepLimits limits{20, 0.0};
+  const Solved serial = solve(start, limits, nullptr);
+  set_thread_pool_size(2);
+  SweepPipeline pipeline;
+  const Solved piped = solve(start, limits, &pipeline);
+  set_thread_pool_size(worker_threads());
+  CHECK(piped.sweeps == serial.sweeps);
+  CHECK(same_bits(piped.state.bodies.velocity, serial.state.bodies.velocity));
+  CHECK(same_impulses(piped.state.manifolds, serial.state.manifolds));
+}
+
 TEST_CASE("sweep pipeline: too few rows for a second thread", "[solver][threads]") {
   set_thread_pool_size(2);
   CHECK(SweepPipeline::parts_for(100) == 1);
