@@ -1,6 +1,7 @@
 #include "scene/scene.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "geometry/convex_partition.hpp"
 #include "geometry/polygon.hpp"
@@ -27,7 +28,10 @@ std::string input_message(const std::string& file, std::uint32_t line, const std
 
 std::int64_t RunSettings::steps() const {
   const double n = std::round(duration / dt);
-  return n < 1.0 ? 1 : static_cast<std::int64_t>(n);
+  // At least one step, also for a NaN (a scene with no run, as a field file's: 0 / 0), and no
+  // more than an int64 holds: a cast of either to an integer is undefined.
+  if (!(n >= 1.0)) return 1;
+  return n < 0x1p63 ? static_cast<std::int64_t>(n) : std::numeric_limits<std::int64_t>::max();
 }
 
 void Scene::derive() {
