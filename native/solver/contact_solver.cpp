@@ -129,10 +129,6 @@ double largest_shortfall_of(std::span<const SweepRow> rows, const BodyArrays& s)
   return worst;
 }
 
-inline void apply_row_impulse(BodyArrays& s, const SweepRow& r, Vec2 impulse) {
-  apply_impulse(s, r.body_a, r.body_b, r.ra, r.rb, impulse);
-}
-
 // The manifolds' points as rows, in sweep order; with the warm start, each point's accumulated
 // impulse applied as it is copied (apply_accumulated_impulses' order and arithmetic).
 template <class Rows>
@@ -177,14 +173,19 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
   double previous_size = 0.0;  // |r_k|^2; 0 before the first sweep
   int max_iterations = limits.iterations;
   int sweep = 0;
+  // The look at what is left closing, past `iterations` every kCheckEvery sweeps: false once no
+  // point is; else true, the limit moved on by kCheckEvery sweeps (within the extra sweeps).
+  auto still_closing = [&] {
+    if (largest_shortfall_of(rows, s) <= limits.closing_speed) return false;
+    max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
+    return true;
+  };
   if (!accelerate && pipeline != nullptr && limits.iterations > 1 && SweepPipeline::parts_for(rows.size()) > 1) {
     // The ordinary sweeps on several threads; then, as the loop below after its sweep
     // `iterations`, the look at what is left closing, and any extra sweeps here.
     const SweepPipeline::Result made = pipeline->run(rows, s, limits.iterations, limits.tolerance);
     sweep = made.sweeps;
-    if (made.converged || limits.extra_iterations <= 0) return sweep;
-    if (largest_shortfall_of(rows, s) <= limits.closing_speed) return sweep;
-    max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
+    if (made.converged || limits.extra_iterations <= 0 || !still_closing()) return sweep;
   }
   while (sweep < max_iterations) {
     ++sweep;
@@ -204,10 +205,9 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
       }
     }
     if (largest_change <= limits.tolerance * largest_impulse) break;
-    if (sweep >= limits.iterations && (sweep - limits.iterations) % kCheckEvery == 0 && limits.extra_iterations > 0) {
-      if (largest_shortfall_of(rows, s) <= limits.closing_speed) break;
-      max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
-    }
+    if (sweep >= limits.iterations && (sweep - limits.iterations) % kCheckEvery == 0 && limits.extra_iterations > 0 &&
+        !still_closing())
+      break;
     if (!accelerate || sweep == max_iterations) continue;
     const std::span<double> p = work.direction;
     const std::span<const double> r = work.change;

@@ -42,6 +42,11 @@ namespace floedem {
   return {pn, pt};
 }
 
+/// Applies `impulse` (on the row's body b; its opposite on a) at the row's contact point.
+inline void apply_row_impulse(BodyArrays& s, const SweepRow& r, Vec2 impulse) {
+  apply_impulse(s, r.body_a, r.body_b, r.ra, r.rb, impulse);
+}
+
 /// The row's impulse change of one sweep (N s).
 struct RowChange {
   double normal = 0.0, tangent = 0.0;
@@ -59,7 +64,7 @@ struct RowChange {
   const double uft = dot(u, t) - (p.wnt * pn0 + p.wtt * pt0);
   const LocalImpulse r = local_impulse(ufn, uft, p.target_velocity, p.friction, p.wnn, p.wnt, p.wtt);
   const double dpn = r.normal - pn0, dpt = r.tangent - pt0;
-  if (dpn != 0.0 || dpt != 0.0) apply_impulse(s, p.body_a, p.body_b, p.ra, p.rb, dpn * n + dpt * t);
+  if (dpn != 0.0 || dpt != 0.0) apply_row_impulse(s, p, dpn * n + dpt * t);
   p.normal_impulse = r.normal;
   p.tangent_impulse = r.tangent;
   return {dpn, dpt};

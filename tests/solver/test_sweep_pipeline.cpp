@@ -92,8 +92,8 @@ bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
 bool same_impulses(const std::vector<Manifold>& a, const std::vector<Manifold>& b) {
   for (std::size_t k = 0; k < a.size(); ++k)
     for (int j = 0; j < a[k].point_count; ++j)
-      if (std::memcmp(&a[k].points[j].normal_impulse, &b[k].points[j].normal_impulse, sizeof(double)) != 0 ||
-          std::memcmp(&a[k].points[j].tangent_impulse, &b[k].points[j].tangent_impulse, sizeof(double)) != 0)
+      if (!floedem::same_bits(a[k].points[j].normal_impulse, b[k].points[j].normal_impulse) ||
+          !floedem::same_bits(a[k].points[j].tangent_impulse, b[k].points[j].tangent_impulse))
         return false;
   return true;
 }
