@@ -28,7 +28,7 @@ namespace {
 constexpr const char* kHeader =
     "host,cpu,threads,floedem_version,scenario,overrides,engine,engine_version,bodies,moving_bodies,dt,steps,"
     "timed_steps,median_ms,mean_ms,p10_ms,p90_ms,setup_s,total_s,contact_fraction,max_penetration_m,"
-    "mean_penetration_m,allocations_per_step,peak_rss_mb";
+    "mean_penetration_m,allocations_per_step,peak_rss_mb,stage_ms";
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
@@ -114,7 +114,10 @@ int run_bench_command(const BenchCommand& c) {
   std::uint64_t allocations_at_window = 0;
   auto last_progress = clock::now();
   for (std::int64_t k = 1; k <= steps; ++k) {
-    if (k == first_timed) allocations_at_window = allocations_so_far();
+    if (k == first_timed) {
+      allocations_at_window = allocations_so_far();
+      stepper.time_stages(true);  // the stages' sums cover the timed steps alone
+    }
     const auto t0 = clock::now();
     stepper.step();
     const auto t1 = clock::now();
@@ -140,6 +143,12 @@ int run_bench_command(const BenchCommand& c) {
     }
   }
   const std::uint64_t allocations = allocations_so_far() - allocations_at_window;
+  // Mean ms a timed step per stage, "name=ms" separated by spaces (one CSV field); empty for an
+  // engine that does not time its stages beyond the forcing and towing.
+  std::ostringstream stages;
+  stages.precision(4);
+  for (const StageTime& t : stepper.stage_times())
+    stages << (stages.tellp() > 0 ? " " : "") << t.name << '=' << 1e3 * t.seconds / static_cast<double>(timed);
   for (const Vec2 p : stepper.state().position)
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) throw SolverFailure("non-finite body state at the end of the run");
   const double total = std::chrono::duration<double>(clock::now() - start).count();
@@ -158,14 +167,21 @@ int run_bench_command(const BenchCommand& c) {
       << steps << ',' << timed << ',' << percentile(ms, 0.5) << ',' << mean << ',' << percentile(ms, 0.1) << ','
       << percentile(ms, 0.9) << ',' << setup << ',' << total << ',' << contact_fraction_sum / static_cast<double>(timed)
       << ',' << max_penetration << ',' << (overlaps > 0 ? penetration_sum / static_cast<double>(overlaps) : 0.0) << ','
-      << static_cast<double>(allocations) / static_cast<double>(timed) << ','
-      << peak_mb;
+      << static_cast<double>(allocations) / static_cast<double>(timed) << ',' << peak_mb << ',' << field(stages.str());
   std::cout << kHeader << '\n' << row.str() << '\n';
   if (!c.csv.empty()) {
     const std::filesystem::path dir = std::filesystem::path(c.csv).parent_path();
     if (!dir.empty() && !std::filesystem::is_directory(dir))
       throw OutputError("cannot append to " + c.csv + ": no directory " + dir.string());
     const bool fresh = !std::filesystem::exists(c.csv) || std::filesystem::file_size(c.csv) == 0;
+    if (!fresh) {  // rows go under a header of the same columns, or not at all
+      std::ifstream in(c.csv);
+      std::string header;
+      std::getline(in, header);
+      if (header != kHeader)
+        throw OutputError("cannot append to " + c.csv + ": its header is not this bench's columns (" + kHeader +
+                          "); write to a new file");
+    }
     std::ofstream out(c.csv, std::ios::app);
     if (fresh) out << kHeader << '\n';
     out << row.str() << '\n';

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/stage_clock.hpp"
 #include "engine/state_io.hpp"
 #include "geometry/vec2.hpp"
 #include "scene/scene.hpp"
@@ -123,6 +124,11 @@ class Engine {
   virtual bool save_state(StateWriter& /*out*/) const { return false; }
   /// Reads what save_state() wrote (StateError when it does not fit this engine and scene).
   virtual void restore_state(StateReader& /*in*/) { throw StateError("this engine cannot restore a checkpoint"); }
+  /// Wall time per stage of step() (`floedem bench`): summed from the call with `on` true.
+  /// Off by default; an engine that does not time its stages ignores it and adds none.
+  virtual void time_stages(bool /*on*/) {}
+  /// Appends each stage's summed wall time, in the order step() makes them.
+  virtual void add_stage_times(std::vector<StageTime>& /*out*/) const {}
 };
 
 }  // namespace floedem

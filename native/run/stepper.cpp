@@ -9,11 +9,26 @@ Stepper::Stepper(const Scene& scene, const std::string& engine)
 
 void Stepper::step() {
   const double start = time();
-  if (tow_.active()) tow_.before_step(engine_->state(), start);
-  loads_ = forcing_.evaluate(engine_->state(), start);
+  if (tow_.active()) stages_.time(kTowing, [&] { tow_.before_step(engine_->state(), start); });
+  stages_.time(kForcing, [&] { loads_ = forcing_.evaluate(engine_->state(), start); });
   engine_->step(loads_);
-  if (tow_.active()) tow_.after_step(engine_->contacts(), forcing_.environment_force(scene_.tow.body));
+  if (tow_.active())
+    stages_.time(kTowing, [&] { tow_.after_step(engine_->contacts(), forcing_.environment_force(scene_.tow.body)); });
   ++steps_;
+}
+
+void Stepper::time_stages(bool on) {
+  stages_.enable(on);
+  engine_->time_stages(on);
+}
+
+std::vector<StageTime> Stepper::stage_times() const {
+  std::vector<StageTime> own, out;
+  stages_.add_to(own);
+  out.push_back(own[kForcing]);
+  engine_->add_stage_times(out);
+  out.push_back(own[kTowing]);
+  return out;
 }
 
 bool Stepper::save(StateWriter& out) const {

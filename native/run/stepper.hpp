@@ -6,6 +6,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "engine/engine.hpp"
 #include "forcing/force_term.hpp"
@@ -34,6 +35,12 @@ class Stepper {
   TowMonitor& tow() { return tow_; }
   const TowMonitor& tow() const { return tow_; }
 
+  /// Wall time per stage of the steps from here on (`floedem bench`): the forcing, the
+  /// engine's own stages (where it times them), the towing bookkeeping. Off by default.
+  void time_stages(bool on);
+  /// Each stage's summed wall time since time_stages(true), in the order a step makes them.
+  std::vector<StageTime> stage_times() const;
+
   /// Checkpoint: the step count, the engine's state and the tow's (the forcing holds none
   /// between steps). False, writing nothing, when the engine cannot save its state.
   bool save(StateWriter& out) const;
@@ -47,6 +54,8 @@ class Stepper {
   TowMonitor tow_;
   std::int64_t steps_ = 0;
   const Loads* loads_ = nullptr;
+  enum Stage : std::size_t { kForcing, kTowing, kStages };
+  StageClock<kStages> stages_{{"forcing", "towing"}};
 };
 
 }  // namespace floedem

@@ -45,6 +45,8 @@ class NativeEngine final : public Engine {
   const BodyStates& state() const override { return bodies_; }
   std::span<const ContactRecord> contacts() const override { return records_; }
   EngineInfo info() const override;
+  void time_stages(bool on) override { stages_.enable(on); }
+  void add_stage_times(std::vector<StageTime>& out) const override { stages_.add_to(out); }
   bool save_state(StateWriter& out) const override;
   void restore_state(StateReader& in) override;
 
@@ -53,7 +55,12 @@ class NativeEngine final : public Engine {
   void pair_up();  // parts placed at the bodies' positions (unchanged within a step)
   bool outran_reach();
   bool meets_unseen_contact();
-  void build_manifolds();
+  void build_manifolds() {
+    collide_pairs();
+    build_contact_list();
+  }
+  void collide_pairs();       // the narrow phase: each pair's manifold into narrow_
+  void build_contact_list();  // narrow_'s contacts into manifolds_, warm-started and classified
   void apply_loads(const Loads& loads);
   void integrate();
   void record();
@@ -76,6 +83,12 @@ class NativeEngine final : public Engine {
   NativeSettings settings_;
   ContactSettings contact_;
   double dt_;
+  // Wall time per stage of step(), when asked for (floedem bench); in step()'s order.
+  enum Stage : std::size_t {
+    kBroad, kNarrow, kContactList, kLoads, kSolve, kRedetect, kIntegrate, kProject, kRecord, kStages
+  };
+  StageClock<kStages> stages_{{"broad_phase", "narrow_phase", "contact_list", "loads", "contact_solve", "redetect",
+                               "integrate", "position_projection", "record"}};
 
   // Hot: touched every step.
   BodyArrays bodies_;
@@ -306,34 +319,39 @@ void NativeEngine::step(const Loads* loads) {
     }
     if (!loads->any && loads->velocity_turn.empty()) loads = nullptr;  // nothing to add: skip the pass
   }
-  find_pairs(loads && loads->any ? loads : nullptr);  // 1. pairs (a velocity turn keeps the speed)
-  build_manifolds();                           // 2. manifolds, classified on the velocities before the step
-  if (loads) apply_loads(*loads);              // 3. non-contact forces
-  if (!manifolds_.empty()) {                   // 4. contact impulses
-    solve_contacts();
+  // 1. pairs (a velocity turn keeps the speed)
+  stages_.time(kBroad, [&] { find_pairs(loads && loads->any ? loads : nullptr); });
+  // 2. manifolds, classified on the velocities before the step
+  stages_.time(kNarrow, [&] { collide_pairs(); });
+  stages_.time(kContactList, [&] { build_contact_list(); });
+  if (loads) stages_.time(kLoads, [&] { apply_loads(*loads); });  // 3. non-contact forces
+  if (!manifolds_.empty()) {                                       // 4. contact impulses
+    stages_.time(kSolve, [&] { solve_contacts(); });
     // A body the impulses sent further than its reach may meet one the pairs did not include
     // (a floe struck at 5 m/s crosses a 5 cm gap to the next in one 0.01 s step), or reach a
     // point of a pair that was beyond the margin (a floe spun by a collision swings its far
     // corner into its neighbour): where the widened reach shows such a contact, the step's
     // contacts are found again and solved again from the velocities after the loads
     // (classified on those: the only difference from a first pass).
-    for (int pass = 0; settings_.redetect && pass < kMaxRedetections && outran_reach() && meets_unseen_contact();
-         ++pass) {
-      // The accumulated impulses are all that the solve applied (warm start included; a cold
-      // restart or a direct solve reset them with the velocities): taken off, the velocities
-      // are those after the loads, to rounding.
-      apply_accumulated_impulses(manifolds_, bodies_, -1.0);
-      std::swap(manifolds_, previous_manifolds_);  // last step's manifolds again, for the warm start
-      pair_up();
-      build_manifolds();
-      solve_contacts();
-      ++redetections_;
-    }
+    stages_.time(kRedetect, [&] {
+      for (int pass = 0; settings_.redetect && pass < kMaxRedetections && outran_reach() && meets_unseen_contact();
+           ++pass) {
+        // The accumulated impulses are all that the solve applied (warm start included; a cold
+        // restart or a direct solve reset them with the velocities): taken off, the velocities
+        // are those after the loads, to rounding.
+        apply_accumulated_impulses(manifolds_, bodies_, -1.0);
+        std::swap(manifolds_, previous_manifolds_);  // last step's manifolds again, for the warm start
+        pair_up();
+        build_manifolds();
+        solve_contacts();
+        ++redetections_;
+      }
+    });
   }
-  integrate();                                 // 5. positions
-  if (settings_.position_iterations > 0 && !manifolds_.empty())
-    solve_positions(manifolds_, bodies_, settings_);  // 6. drift correction, positions only
-  record();                                    // 7. impulses for the recorder
+  stages_.time(kIntegrate, [&] { integrate(); });  // 5. positions
+  if (settings_.position_iterations > 0 && !manifolds_.empty())  // 6. drift correction, positions only
+    stages_.time(kProject, [&] { solve_positions(manifolds_, bodies_, settings_); });
+  stages_.time(kRecord, [&] { record(); });  // 7. impulses for the recorder
   ++steps_;
 }
 
@@ -466,10 +484,7 @@ PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
   return parts_.geometry(k, bodies_.position[b], bodies_.rotation[b]);
 }
 
-void NativeEngine::build_manifolds() {
-  // The contact list is written over the one of two lists ago, slot by slot (copy_manifold
-  // writes what each contact holds, not the whole struct), and cut to length at the end.
-  std::swap(manifolds_, previous_manifolds_);
+void NativeEngine::collide_pairs() {
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
   narrow_.resize(pairs_.size());
@@ -528,8 +543,15 @@ void NativeEngine::build_manifolds() {
     }
     block_contacts_[begin / kPairGrain + 1] = found;
   });
+}
+
+void NativeEngine::build_contact_list() {
+  // The contact list is written over the one of two lists ago, slot by slot (copy_manifold
+  // writes what each contact holds, not the whole struct), and cut to length at the end.
+  std::swap(manifolds_, previous_manifolds_);
   // The contacts, in pair order, each into its slot of the list: per block of pairs (the
   // narrow phase's blocks), its first slot is the count of contacts in the blocks before it.
+  const std::size_t blocks = block_contacts_.size() - 1;
   for (std::size_t b = 0; b < blocks; ++b) block_contacts_[b + 1] += block_contacts_[b];
   const std::size_t contacts = block_contacts_[blocks];
   if (manifolds_.size() < contacts) resize_with_headroom(manifolds_, contacts);

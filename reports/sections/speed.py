@@ -125,6 +125,7 @@ def write(ctx):
     md += targets(rows)
     figure(ctx, rows)
     md += ["![ms per step against floes](fig/speed_field.png)", ""]
+    md += stages_section(ctx, rows, every)
     md += cost_against_error(ctx, every)
     if scaling:
         one = scaling[0][1]
@@ -140,6 +141,109 @@ def write(ctx):
         md += ["", "![ms per step and speed-up against threads](fig/speed_threads.png)", ""]
         threads_figure(ctx, scaling, every)
     return md, []
+
+
+def stages(row):
+    """A bench row's stage_ms column ("name=ms ..."): {stage: mean ms per timed step}, in order."""
+    out = {}
+    for item in (row.get("stage_ms") or "").split():
+        name, _, ms = item.partition("=")
+        out[name] = float(ms)
+    return out
+
+
+# The stages as the report names them (native/solver/native_engine.cpp, NativeEngine::step, and
+# the forcing and towing of native/run/stepper.cpp), in the order of a step.
+STAGE_LABELS = {"forcing": "forcing (environment terms)", "broad_phase": "broad phase", "narrow_phase": "narrow phase",
+                "contact_list": "contact list (warm start, classify)", "loads": "loads",
+                "contact_solve": "contact solve (islands, sweeps)", "redetect": "redetect",
+                "integrate": "integrate", "position_projection": "position projection", "record": "record",
+                "towing": "towing"}
+
+
+def stages_section(ctx, rows, every):
+    """Where native's step goes: mean ms per step by stage (`floedem bench` times each stage of
+    every timed step, the stage_ms column), on the field sizes and the towing case, and on 1 and
+    more threads: what a target left unmet would have to shrink, and what does not scale."""
+    runs = [(t, r) for t, r in sorted(rows.items(), key=lambda kv: int(kv[1]["bodies"]))
+            if r["engine"] == "native" and stages(r)]
+    if not runs:
+        return []
+    names = [n for n in STAGE_LABELS if any(stages(r).get(n, 0.0) > 0.0 for _, r in runs)]
+
+    def label(tag):
+        parts = tag.split("_")
+        return f"field {parts[2]}" if tag.startswith("speed_field") else parts[1]
+
+    md = ["Where native's step goes: mean ms per step by stage over the same timed windows (`floedem bench` "
+          "times each stage of every timed step: the `stage_ms` column of `bench.csv`). The stages add up to the "
+          "mean step; the median above is a little below the mean.", "",
+          "| stage | " + " | ".join(label(t) for t, _ in runs) + " |", "|---|" + "---|" * len(runs)]
+    for n in names:
+        cells = []
+        for _, r in runs:
+            st = stages(r)
+            total = sum(st.values())
+            cells.append(f"{st.get(n, 0.0):.3f} ({100 * st.get(n, 0.0) / total:.0f} %)" if total > 0 else "-")
+        md.append(f"| {STAGE_LABELS[n]} | " + " | ".join(cells) + " |")
+    md.append("| **sum** | " + " | ".join(f"**{sum(stages(r).values()):.3f}**" for _, r in runs) + " |")
+    md.append("")
+    # The 16k target as a budget: what the step would have to cost, against what its stages cost.
+    n16, b16 = rows.get("speed_field_16k_native"), rows.get("speed_field_16k_box2d")
+    if n16 and b16 and stages(n16):
+        budget = float(b16["median_ms"]) / TARGET_VS["box2d"]
+        st = stages(n16)
+        top = sorted(st.items(), key=lambda kv: -kv[1])[:3]
+        md += [f"At 16 000 floes, {TARGET_VS['box2d']:g}x Box2D's {float(b16['median_ms']):.1f} ms is a budget of "
+               f"{budget:.1f} ms a step against native's {float(n16['median_ms']):.1f}; its three largest stages, "
+               + ", ".join(f"{STAGE_LABELS[k]} {v:.1f} ms" for k, v in top)
+               + f", cost {sum(v for _, v in top):.1f} ms together.", ""]
+    threads = sorted(((int(r["threads"]), r) for t, r in every.items() if t.startswith("speed_threads_") and stages(r)),
+                     key=lambda x: x[0])
+    stages_figure(ctx, runs, names, label, threads)
+    md += ["![ms per step by stage](fig/speed_stages.png)", ""]
+    return md
+
+
+def stages_figure(ctx, runs, names, label, threads):
+    """Left: each native run's step as shares of its stages. Right: ms per stage against the
+    thread count on the scaling runs (a stage that stays flat runs on one thread)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2))
+    colours = plt.get_cmap("tab20")(range(len(names)))
+    for y, (tag, r) in enumerate(runs):
+        st = stages(r)
+        total = sum(st.values()) or 1.0
+        left = 0.0
+        for k, n in enumerate(names):
+            share = 100 * st.get(n, 0.0) / total
+            ax.barh(y, share, left=left, color=colours[k], label=STAGE_LABELS[n] if y == 0 else None)
+            left += share
+    ax.set_yticks(range(len(runs)))
+    ax.set_yticklabels([f"{label(t)} ({sum(stages(r).values()):.2f} ms)" for t, r in runs])
+    ax.set_xlabel("share of the step (%)")
+    ax.set_xlim(0, 100)
+    ax.set_title("native, one thread: where a step goes", fontsize=9)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=3)
+    if threads:
+        counts = [t for t, _ in threads]
+        for k, n in enumerate(names):
+            ms = [stages(r).get(n, 0.0) for _, r in threads]
+            if max(ms) > 0.01 * sum(stages(threads[0][1]).values()):  # the stages of at least 1 % of the step
+                bx.plot(counts, ms, "o-", color=colours[k], label=STAGE_LABELS[n])
+        bx.set_xticks(counts)
+        bx.set_xlabel("threads (FLOEDEM_THREADS)")
+        bx.set_ylabel("ms per step (mean)")
+        bx.set_ylim(bottom=0)
+        bx.set_title(f"native, {threads[0][1]['scenario']}: stages against threads", fontsize=9)
+        bx.legend(fontsize=7)
+    else:
+        bx.set_axis_off()
+    fig.tight_layout()
+    fig.savefig(os.path.join(ctx.fig, "speed_stages.png"), dpi=110)
+    plt.close(fig)
 
 
 def threads_figure(ctx, scaling, every):

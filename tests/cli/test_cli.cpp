@@ -138,6 +138,15 @@ TEST_CASE("cli: floedem bench prints and appends one CSV row, bad input exits 2"
   CHECK(columns(header) == columns(row));
   CHECK(header.rfind("host,cpu,threads,", 0) == 0);
   CHECK(row.find(",native,floedem,2,2,") != std::string::npos);  // engine, version, bodies, moving
+  CHECK(row.find("contact_solve=") != std::string::npos);          // stage_ms: native times its stages
+  // A file of other columns (an older bench's) is not appended to: the row would not fit.
+  const fs::path old_csv = d / "old.csv";
+  const std::string old_rows = "host,cpu,threads,median_ms\nvm,x,1,1.0\n";
+  std::ofstream(old_csv) << old_rows;
+  const Result refused = run("bench " + scenario + " --set run.duration=2 --csv " + old_csv.string() + " -q");
+  CHECK(refused.code != 0);
+  CHECK(refused.output.find("header") != std::string::npos);
+  CHECK(fs::file_size(old_csv) == old_rows.size());
   CHECK(fs::exists(csv));
   CHECK(run("bench " + scenario + " --engine nosuch").code == 2);
   CHECK(run("bench " + (d / "missing.toml").string()).code == 2);

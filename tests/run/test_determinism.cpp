@@ -1,15 +1,19 @@
 // The same scenario twice gives bit-identical output, on every engine.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <random>
 
 #include "engine/registry.hpp"
 #include "parallel/thread_pool.hpp"
 #include "parallel/threads.hpp"
 #include "run/simulation.hpp"
+#include "run/stepper.hpp"
 #include "scenario/scenario.hpp"
 #include "support.hpp"
 
@@ -85,4 +89,55 @@ TEST_CASE("determinism: the same file on 1 and on 4 threads", "[determinism]") {
   CHECK(files[0].size() == files[1].size());
   CHECK(files[0] == files[1]);
   fs::remove_all(dir);
+}
+
+TEST_CASE("determinism: timing the stages changes nothing, and the stages add up", "[determinism][stages]") {
+  // `floedem bench` times each stage of a step (Stepper::time_stages): the same steps with the
+  // clocks on must give the same state to the bit, and the stages' sums must account for the
+  // steps' wall time without exceeding it.
+  const Scene s = load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml",
+                                {"run.duration=20"});
+  Stepper plain(s, "native"), timed(s, "native");
+  timed.time_stages(true);
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < 200; ++k) timed.step();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (int k = 0; k < 200; ++k) plain.step();
+  const BodyStates& a = plain.state();
+  const BodyStates& b = timed.state();
+  REQUIRE(a.position.size() == b.position.size());
+  for (std::size_t i = 0; i < a.position.size(); ++i) {
+    INFO("body " << i);
+    REQUIRE(same_bits(a.position[i].x, b.position[i].x));
+    REQUIRE(same_bits(a.position[i].y, b.position[i].y));
+    REQUIRE(same_bits(a.angle[i], b.angle[i]));
+    REQUIRE(same_bits(a.velocity[i].x, b.velocity[i].x));
+    REQUIRE(same_bits(a.velocity[i].y, b.velocity[i].y));
+    REQUIRE(same_bits(a.angular_velocity[i], b.angular_velocity[i]));
+  }
+
+  std::vector<std::string> names;
+  std::map<std::string, double> seconds;
+  double sum = 0.0;
+  for (const StageTime& t : timed.stage_times()) {
+    names.push_back(t.name);
+    seconds[t.name] = t.seconds;
+    CHECK(t.seconds >= 0.0);
+    sum += t.seconds;
+  }
+  CHECK(names == std::vector<std::string>{"forcing", "broad_phase", "narrow_phase", "contact_list", "loads",
+                                          "contact_solve", "redetect", "integrate", "position_projection", "record",
+                                          "towing"});
+  // A drifting field in contact: drag, pairs, contacts and impulses every step; no tow.
+  CHECK(seconds["forcing"] > 0.0);
+  CHECK(seconds["narrow_phase"] > 0.0);
+  CHECK(seconds["contact_solve"] > 0.0);
+  CHECK(seconds["towing"] == 0.0);
+  CHECK(sum <= wall);
+  CHECK(sum > 0.5 * wall);  // the stages are the step: what lies between them is a few calls
+
+  // Off (the default): nothing is summed.
+  double untimed = 0.0;
+  for (const StageTime& t : plain.stage_times()) untimed += t.seconds;
+  CHECK(untimed == 0.0);
 }
