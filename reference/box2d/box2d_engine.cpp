@@ -47,12 +47,15 @@ class Box2dEngine final : public Engine, public b2ContactListener {
   const BodyStates& state() const override { return state_; }
   std::span<const ContactRecord> contacts() const override { return records_; }
   EngineInfo info() const override;
+  void time_stages(bool on) override { adapter_stages_.enable(on); }
+  void add_stage_times(std::vector<StageTime>& out) const override;
 
   // b2ContactListener
   void PreSolve(b2Contact* contact, const b2Manifold* old_manifold) override;
   void PostSolve(b2Contact* contact, const b2ContactImpulse* impulse) override;
 
  private:
+  void apply_loads(const Loads& loads);
   void publish();
   Vec2 point_velocity(const b2Body* b, b2Vec2 p) const {
     const b2Vec2 v = b->GetLinearVelocityFromWorldPoint(p);
@@ -73,6 +76,14 @@ class Box2dEngine final : public Engine, public b2ContactListener {
   bool approach_sorted_ = false;
   std::vector<ContactRecord> records_;
   BodyStates state_;
+  // Stage times (floedem bench): the adapter's own work around b2World::Step, and Box2D's
+  // b2Profile of each step (its own timers, which run whether or not they are read), summed.
+  enum AdapterStage : std::size_t { kLoads, kPublish, kAdapterStages };
+  StageClock<kAdapterStages> adapter_stages_{{"loads", "publish"}};
+  struct ProfileSums {
+    double collide = 0.0, broadphase = 0.0, solve = 0.0, solve_init = 0.0, solve_velocity = 0.0,
+           solve_position = 0.0, toi = 0.0, step = 0.0;  // ms
+  } profile_;
 };
 
 Box2dEngine::Box2dEngine(const Scene& scene)
@@ -195,27 +206,20 @@ void Box2dEngine::PostSolve(b2Contact* contact, const b2ContactImpulse* impulse)
 void Box2dEngine::step(const Loads* loads) {
   records_.clear();
   approach_.clear();
-  if (loads) {
-    for (const PrescribedMotion& p : loads->prescribed) {
-      bodies_[p.body]->SetLinearVelocity(b2Vec2(static_cast<float>(p.velocity.x), static_cast<float>(p.velocity.y)));
-      bodies_[p.body]->SetAngularVelocity(static_cast<float>(p.angular_velocity));
-    }
-    if (!loads->velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
-      for (std::size_t i = 0; i < bodies_.size(); ++i) {
-        if (bodies_[i]->GetType() != b2_dynamicBody) continue;
-        const b2Vec2 v = bodies_[i]->GetLinearVelocity();
-        const Vec2 turned = loads->velocity_turn[i].apply({v.x, v.y});
-        bodies_[i]->SetLinearVelocity(b2Vec2(static_cast<float>(turned.x), static_cast<float>(turned.y)));
-      }
-    if (loads->any)
-      for (std::size_t i = 0; i < bodies_.size(); ++i) {
-        if (bodies_[i]->GetType() != b2_dynamicBody) continue;
-        bodies_[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(loads->force[i].x), static_cast<float>(loads->force[i].y)), true);
-        bodies_[i]->ApplyTorque(static_cast<float>(loads->torque[i]), true);
-      }
-  }
+  if (loads) adapter_stages_.time(kLoads, [&] { apply_loads(*loads); });
   world_.Step(static_cast<float>(dt_), settings_.velocity_iterations, settings_.position_iterations);
-  publish();
+  if (adapter_stages_.enabled()) {
+    const b2Profile& p = world_.GetProfile();
+    profile_.collide += p.collide;
+    profile_.broadphase += p.broadphase;
+    profile_.solve += p.solve;
+    profile_.solve_init += p.solveInit;
+    profile_.solve_velocity += p.solveVelocity;
+    profile_.solve_position += p.solvePosition;
+    profile_.toi += p.solveTOI;
+    profile_.step += p.step;
+  }
+  adapter_stages_.time(kPublish, [&] { publish(); });
   // Box2D clamps a body's motion per step at b2_maxTranslation (2 m) and b2_maxRotation
   // (pi/2) without a word: refuse rather than return a silently slowed run.
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
@@ -226,6 +230,46 @@ void Box2dEngine::step(const Loads* loads) {
                           " m (or turn " + std::to_string(turn) + " rad) in one step of " + std::to_string(dt_) +
                           " s; Box2D caps a step at 2 m and pi/2 rad and would slow it silently: use a shorter dt");
   }
+}
+
+void Box2dEngine::add_stage_times(std::vector<StageTime>& out) const {
+  // b2World::Step (Box2D 2.4.1): Collide() (the narrow phase of every contact whose fat boxes
+  // overlap, our PreSolve included), then Solve(): islands built, each integrated and solved
+  // (solveInit: warm start and constraint set-up; solveVelocity; solvePosition), then the
+  // fixtures synchronised and new pairs found (broadphase); then SolveTOI (off here). What
+  // Solve() spends outside those (island search, integration) is "islands_integrate".
+  std::vector<StageTime> own;
+  adapter_stages_.add_to(own);
+  const ProfileSums& p = profile_;
+  const double solver = p.solve_init + p.solve_velocity + p.solve_position;
+  out.push_back(own[kLoads]);
+  out.push_back({"narrow_phase", 1e-3 * p.collide});
+  out.push_back({"contact_solve", 1e-3 * solver});
+  out.push_back({"islands_integrate", 1e-3 * std::max(0.0, p.solve - solver - p.broadphase)});
+  out.push_back({"broad_phase", 1e-3 * p.broadphase});
+  out.push_back({"toi", 1e-3 * p.toi});
+  out.push_back({"step_other", 1e-3 * std::max(0.0, p.step - p.collide - p.solve - p.toi)});
+  out.push_back(own[kPublish]);
+}
+
+void Box2dEngine::apply_loads(const Loads& loads) {
+  for (const PrescribedMotion& p : loads.prescribed) {
+    bodies_[p.body]->SetLinearVelocity(b2Vec2(static_cast<float>(p.velocity.x), static_cast<float>(p.velocity.y)));
+    bodies_[p.body]->SetAngularVelocity(static_cast<float>(p.angular_velocity));
+  }
+  if (!loads.velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+      if (bodies_[i]->GetType() != b2_dynamicBody) continue;
+      const b2Vec2 v = bodies_[i]->GetLinearVelocity();
+      const Vec2 turned = loads.velocity_turn[i].apply({v.x, v.y});
+      bodies_[i]->SetLinearVelocity(b2Vec2(static_cast<float>(turned.x), static_cast<float>(turned.y)));
+    }
+  if (loads.any)
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+      if (bodies_[i]->GetType() != b2_dynamicBody) continue;
+      bodies_[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(loads.force[i].x), static_cast<float>(loads.force[i].y)), true);
+      bodies_[i]->ApplyTorque(static_cast<float>(loads.torque[i]), true);
+    }
 }
 
 void Box2dEngine::publish() {
