@@ -23,6 +23,7 @@ class Run:
     bench_window: float = 0.0   # > 0: a timing run, `floedem bench --window W`, into TAG.csv,
                                 # made after the others, alone (nothing else shares the cores)
     threads: int = 0            # FLOEDEM_THREADS; 0: 1 for a timing run, else the cores / jobs
+    bench_stages: bool = False  # a timing run that also times each stage (`floedem bench --stages`)
 
     @property
     def timed(self):
@@ -31,7 +32,7 @@ class Run:
     def command(self, floedem):
         if self.timed:
             cmd = [floedem, "bench", self.scenario, "-e", self.engine, "--window", repr(self.bench_window),
-                   "--csv", self.out, "-q"]
+                   "--csv", self.out, "-q"] + (["--stages"] if self.bench_stages else [])
         else:
             cmd = [floedem, "run", self.scenario, "-e", self.engine, "-o", self.out, "-q"]
         for s in self.sets:

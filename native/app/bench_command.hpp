@@ -18,6 +18,7 @@ struct BenchCommand {
   double window = 0.0;   ///< s of model time at the end of the run that are timed; 0: all of it
   std::string csv;       ///< append the row here (header first when the file is new); empty: stdout only
   bool quiet = false;
+  bool stages = false;   ///< time each stage of the timed steps (the stage_ms column)
 };
 
 CLI::App* add_bench_command(CLI::App& app, BenchCommand& c);

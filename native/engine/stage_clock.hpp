@@ -1,9 +1,9 @@
 #pragma once
 // Wall time per stage of a step, for `floedem bench` (where a step's time goes: the report's
-// speed section). Off unless asked for (Engine::time_stages): then each stage reads the clock
-// twice, about 50 ns a stage on Linux's vDSO clock, nothing against a field's milliseconds, but
-// not nothing against a one-body step (BM_StepNoEnvironment/1), hence the switch. The timing
-// changes nothing the step computes.
+// speed section). Off unless asked for (Engine::time_stages, `floedem bench --stages`): then
+// each stage reads the clock twice, some 25 ns a stage on Linux's vDSO clock: nothing against a
+// field's milliseconds, but a two-floe impact's 0.1 us step takes 0.37 us with it, hence the
+// switch. The timing changes nothing the step computes.
 #include <array>
 #include <chrono>
 #include <cstddef>

@@ -121,15 +121,17 @@ TEST_CASE("cli: floedem bench prints and appends one CSV row, bad input exits 2"
   const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/head_on.toml";
   const fs::path csv = d / "b.csv";
   for (int k = 0; k < 2; ++k) {
-    const Result r = run("bench " + scenario + " --window 0.5 --set run.duration=2 --csv " + csv.string() + " -q");
+    const Result r = run("bench " + scenario + " --window 0.5 --set run.duration=2 --csv " + csv.string() + " -q" +
+                         (k == 0 ? " --stages" : ""));
     CHECK(r.code == 0);
     CHECK(r.output.find("median_ms") != std::string::npos);
   }
   std::ifstream in(csv);
-  std::string header, row, line;
+  std::string header, first, row, line;
   std::getline(in, header);
   int rows = 0;
   while (std::getline(in, line)) {
+    if (rows == 0) first = line;
     row = line;
     ++rows;
   }
@@ -138,7 +140,8 @@ TEST_CASE("cli: floedem bench prints and appends one CSV row, bad input exits 2"
   CHECK(columns(header) == columns(row));
   CHECK(header.rfind("host,cpu,threads,", 0) == 0);
   CHECK(row.find(",native,floedem,2,2,") != std::string::npos);  // engine, version, bodies, moving
-  CHECK(row.find("contact_solve=") != std::string::npos);          // stage_ms: native times its stages
+  CHECK(first.find("contact_solve=") != std::string::npos);  // --stages: native times its own stages
+  CHECK(row.back() == ',');                                   // without: stage_ms is left empty
   // A file of other columns (an older bench's) is not appended to: the row would not fit.
   const fs::path old_csv = d / "old.csv";
   const std::string old_rows = "host,cpu,threads,median_ms\nvm,x,1,1.0\n";
