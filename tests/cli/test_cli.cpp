@@ -180,6 +180,13 @@ std::map<std::string, std::string> bench_row(const std::string& args, const std:
   for (std::size_t k = 0; k < header.size(); ++k) by_name[header[k]] = row[k];
   return by_name;
 }
+
+/// A bench row's number in column `name` (which must be there).
+double number(const std::map<std::string, std::string>& row, const std::string& name) {
+  INFO("column " << name);
+  REQUIRE(row.count(name) == 1);
+  return std::stod(row.at(name));
+}
 }  // namespace
 
 TEST_CASE("cli: no heap allocation in the steady state of a packed field", "[cli][allocations]") {
@@ -193,12 +200,12 @@ TEST_CASE("cli: no heap allocation in the steady state of a packed field", "[cli
   const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml";
   for (const char* threads : {"1", "2"}) {
     INFO("FLOEDEM_THREADS=" << threads);
-    auto row = bench_row(scenario + " --window 50 -q", std::string("FLOEDEM_THREADS=") + threads + " ");
-    CHECK(std::stod(row["contact_fraction"]) > 0.95);  // packed: the state the check is about
-    CHECK(std::stoi(row["timed_steps"]) == 1000);
-    CHECK(std::stod(row["allocations_per_step"]) == 0.0);
+    const auto row = bench_row(scenario + " --window 50 -q", std::string("FLOEDEM_THREADS=") + threads + " ");
+    CHECK(number(row, "contact_fraction") > 0.95);  // packed: the state the check is about
+    CHECK(number(row, "timed_steps") == 1000);
+    CHECK(number(row, "allocations_per_step") == 0.0);
   }
   // The counter counts: timed from the first step, the lists' first growth shows.
-  auto first_steps = bench_row(scenario + " --set run.duration=5 -q", "FLOEDEM_THREADS=1 ");
-  CHECK(std::stod(first_steps["allocations_per_step"]) > 0.0);
+  const auto first_steps = bench_row(scenario + " --set run.duration=5 -q", "FLOEDEM_THREADS=1 ");
+  CHECK(number(first_steps, "allocations_per_step") > 0.0);
 }
