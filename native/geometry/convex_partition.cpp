@@ -2,6 +2,7 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Partition_traits_2.h>
+#include <CGAL/Polygon_2_algorithms.h>
 #include <CGAL/partition_2.h>
 
 #include <iterator>
@@ -22,6 +23,14 @@ std::vector<std::vector<Vec2>> convex_partition(std::span<const Vec2> ccw_polygo
   std::vector<Point> input;
   input.reserve(ccw_polygon.size());
   for (const Vec2 p : ccw_polygon) input.emplace_back(p.x, p.y);
+
+  // CGAL's partitions require a simple counter-clockwise polygon, and check it only in debug
+  // builds. The scene's checks (scenario.cpp) hold in floating point; a sliver can pass them
+  // and still fail CGAL's exact predicates once shifted to its centroid (the fuzzer's triangle
+  // 9 m wide and 7.8e6 m long: CGAL then popped an empty list). Such a polygon has no parts.
+  if (!CGAL::is_simple_2(input.begin(), input.end(), Kernel()) ||
+      CGAL::orientation_2(input.begin(), input.end(), Kernel()) != CGAL::COUNTERCLOCKWISE)
+    return {};
 
   std::list<Polygon> parts;
   if (input.size() <= 64)
