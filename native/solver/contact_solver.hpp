@@ -133,10 +133,20 @@ double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& 
 /// applying the difference to the bodies. Returns how many were cut.
 int clamp_friction(std::span<Manifold> manifolds, BodyArrays& bodies);
 
+/// What solve_positions keeps between its sweeps and between steps (grown with headroom: no
+/// allocation per step in the steady state).
+struct ProjectionWork {
+  std::uint64_t clock = 0;               ///< evaluations of a manifold so far (never reset)
+  std::vector<std::uint64_t> moved;      ///< per body: the evaluation that last changed its pose
+  std::vector<std::uint64_t> evaluated;  ///< per manifold: the evaluation that last measured its gaps
+  std::vector<double> depth;             ///< ... and the deepest of those gaps then (m, >= 0)
+};
+
 /// Nonlinear Gauss-Seidel on positions (Box2D v2.4's position solver): pushes overlapping
 /// bodies apart beyond `allowed_penetration`, touching positions only, never velocities, so
 /// that drift correction adds no kinetic energy. Returns the deepest penetration found (m, >= 0).
-double solve_positions(std::span<const Manifold> manifolds, BodyArrays& bodies, const NativeSettings& settings);
+double solve_positions(std::span<const Manifold> manifolds, BodyArrays& bodies, const NativeSettings& settings,
+                       ProjectionWork& work);
 
 /// The exact solution of the single-contact problem (Newton restitution with Coulomb
 /// friction, see contact_solver.cpp). u_free: relative velocity (n, t) without this

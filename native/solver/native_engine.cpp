@@ -124,6 +124,7 @@ class NativeEngine final : public Engine {
   void forget_narrow();                    // no reuse at the next narrow phase
   std::vector<Manifold> manifolds_, previous_manifolds_;
   std::vector<ContactRecord> records_;
+  ProjectionWork projection_;             // the position projection's stamps (what moved since measured)
   // Measured figures, reported by info(): solver work and warm-start fallbacks over the run.
   std::int64_t total_sweeps_ = 0;          // per step, the most sweeps any island took
   std::int64_t total_islands_ = 0;
@@ -350,7 +351,7 @@ void NativeEngine::step(const Loads* loads) {
   }
   stages_.time(kIntegrate, [&] { integrate(); });  // 5. positions
   if (settings_.position_iterations > 0 && !manifolds_.empty())  // 6. drift correction, positions only
-    stages_.time(kProject, [&] { solve_positions(manifolds_, bodies_, settings_); });
+    stages_.time(kProject, [&] { solve_positions(manifolds_, bodies_, settings_, projection_); });
   stages_.time(kRecord, [&] { record(); });  // 7. impulses for the recorder
   ++steps_;
 }
