@@ -115,6 +115,7 @@ class NativeEngine final : public Engine {
   // position and rotation the same to the bit) with the same reaches gets the manifold computed
   // last time, not a new one. In the towing case most pairs are of floes at rest.
   bool any_kept_ = false;                  // any part kept (else no reuse is looked for: a drifting field)
+  bool redetecting_ = false;               // the narrow phase of a redetection (every part where it was)
   std::vector<Manifold> previous_narrow_;  // the last narrow phase's results ...
   std::vector<PartPair> previous_pairs_;   // ... for these pairs ...
   std::vector<double> previous_reach_;     // ... with these part reaches
@@ -343,7 +344,9 @@ void NativeEngine::step(const Loads* loads) {
         apply_accumulated_impulses(manifolds_, bodies_, -1.0);
         std::swap(manifolds_, previous_manifolds_);  // last step's manifolds again, for the warm start
         pair_up();
+        redetecting_ = true;
         build_manifolds();
+        redetecting_ = false;
         solve_contacts();
         ++redetections_;
       }
@@ -491,7 +494,10 @@ void NativeEngine::collide_pairs() {
   narrow_.resize(pairs_.size());
   // Per pair, its slot at the last narrow phase (both lists sorted): its separation hint
   // carries over, and where both parts were kept in place with the same reaches, its manifold.
-  const bool may_reuse = any_kept_ && !previous_pairs_.empty();
+  // A redetection's narrow phase follows the step's first one with every part where it was
+  // (only the reaches of the bodies that outran theirs grew): each pair of parts whose reaches
+  // stayed the same gets the first one's manifold.
+  const bool may_reuse = (any_kept_ || redetecting_) && !previous_pairs_.empty();
   if (may_reuse) resize_with_headroom(reuse_, pairs_.size());
   resize_with_headroom(narrow_hint_, pairs_.size());
   auto same_reach = [&](std::int32_t part) {
@@ -505,7 +511,8 @@ void NativeEngine::collide_pairs() {
     narrow_hint_[k] = met ? previous_hint_[last] : SeparationHint{};
     if (!may_reuse) continue;
     reuse_[k] = -1;
-    if (met && parts_.kept()[pair.a] && parts_.kept()[pair.b] && same_reach(pair.a) && same_reach(pair.b)) {
+    if (met && (redetecting_ || (parts_.kept()[pair.a] && parts_.kept()[pair.b])) && same_reach(pair.a) &&
+        same_reach(pair.b)) {
       reuse_[k] = static_cast<std::int32_t>(last);
       ++narrow_reused_;
     }
