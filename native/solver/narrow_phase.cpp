@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <type_traits>
 
 namespace floedem {
 
@@ -61,7 +62,8 @@ ClosestPoints closest_points(const ConvexView& ref, const ConvexView& inc) {
   return best;
 }
 
-void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip, double margin, Manifold& m) {
+template <class M>
+void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip, double margin, M& m) {
   const ClosestPoints c = closest_points(ref.world, inc.world);
   // Touching (the direction undefined) or beyond reach: no contact.
   if (!(c.distance > 1e-9) || c.distance > margin) return;
@@ -72,18 +74,18 @@ void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip,
   // incident point, both carried with their bodies.
   m.local_normal = ref.body_transform.q.apply_inverse(n);
   m.local_face_point = ref.body_transform.apply_inverse(c.on_ref);
-  ManifoldPoint& p = m.points[m.point_count++];
-  p = ManifoldPoint{};
+  auto& p = m.points[m.point_count++];
+  p = std::remove_reference_t<decltype(p)>{};
   p.point = 0.5 * (c.on_ref + c.on_inc);
   p.separation = c.distance;
   p.id = (flip ? 0x80000000u : 0u) | 0x40000000u | (c.ref_feature << 16) | c.inc_feature;
   p.local_incident = inc.body_transform.apply_inverse(c.on_inc);
 }
 
-}  // namespace
-
-void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m,
-             SeparationHint* hint) {
+// collide() into either manifold type: the same arithmetic, the same fields.
+template <class M>
+void collide_into(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, M& m,
+                  SeparationHint* hint) {
   m.point_count = 0;
   // The last test's best edges first (a pair's two floes turn little in a step). Whichever
   // test says "apart" first, the answer is the same (no contact), and either polygon's largest
@@ -157,13 +159,25 @@ void collide(const PartGeometry& a, const PartGeometry& b, double margin, double
   for (const ClipVertex& cv : clip2) {
     const double s = dot(n, cv.p) - face_offset;
     if (s > margin) continue;
-    ManifoldPoint& p = m.points[m.point_count++];
-    p = ManifoldPoint{};
+    auto& p = m.points[m.point_count++];
+    p = std::remove_reference_t<decltype(p)>{};
     p.point = cv.p - 0.5 * s * n;
     p.separation = s;
     p.id = (flip ? 0x80000000u : 0u) | (static_cast<std::uint32_t>(edge) << 16) | cv.feature;
     p.local_incident = inc.body_transform.apply_inverse(cv.p);
   }
+}
+
+}  // namespace
+
+void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m,
+             SeparationHint* hint) {
+  collide_into(a, b, margin, flip_tolerance, m, hint);
+}
+
+void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance,
+             NarrowManifold& m, SeparationHint* hint) {
+  collide_into(a, b, margin, flip_tolerance, m, hint);
 }
 
 }  // namespace floedem

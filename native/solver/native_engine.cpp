@@ -67,7 +67,7 @@ class NativeEngine final : public Engine {
   PartGeometry part_geometry(std::int32_t k) const;
   double reach_of_part(std::int32_t k) const;
   Aabb reach_box(std::int32_t k, double reach) const;
-  void collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m,
+  void collide_parts(PartPair pair, double reach_a, double reach_b, NarrowManifold& m,
                      SeparationHint* hint = nullptr) const;
   void solve_contacts();
   struct IslandWork;
@@ -106,7 +106,7 @@ class NativeEngine final : public Engine {
   std::vector<double> part_margin_;        // per part: room of its fat box in the pair cache
   PairCache pair_cache_;
   std::vector<PartPair> pairs_;
-  std::vector<Manifold> narrow_;          // per pair this step: the narrow phase's result
+  std::vector<NarrowManifold> narrow_;    // per pair this step: the narrow phase's result
   // Per pair, the edges that separated most at its last test, tried first (sat.hpp): the same
   // manifolds, found sooner (a pair's floes turn little in a step).
   std::vector<SeparationHint> narrow_hint_, previous_hint_;
@@ -116,7 +116,7 @@ class NativeEngine final : public Engine {
   // last time, not a new one. In the towing case most pairs are of floes at rest.
   bool any_kept_ = false;                  // any part kept (else no reuse is looked for: a drifting field)
   bool redetecting_ = false;               // the narrow phase of a redetection (every part where it was)
-  std::vector<Manifold> previous_narrow_;  // the last narrow phase's results ...
+  std::vector<NarrowManifold> previous_narrow_;  // the last narrow phase's results ...
   std::vector<PartPair> previous_pairs_;   // ... for these pairs ...
   std::vector<double> previous_reach_;     // ... with these part reaches
   std::vector<std::int32_t> reuse_;        // per pair: its slot in previous_narrow_, or -1
@@ -393,7 +393,7 @@ bool NativeEngine::meets_unseen_contact() {
   const double slop = 0.5 * settings_.allowed_penetration;
   auto grown = [&](std::int32_t k) { return reach_box(k, reach_of_part(k)); };
   bool unseen = false;
-  Manifold probe;
+  NarrowManifold probe;
   for (std::size_t x = 0; x < outran_list_.size() && !unseen; ++x) {
     const std::int32_t body = outran_list_[x];
     for (std::int32_t k = parts_.first_part(body); k < parts_.first_part(body + 1) && !unseen; ++k) {
@@ -408,7 +408,7 @@ bool NativeEngine::meets_unseen_contact() {
         const auto held = find_pair(manifolds_, pair);
         const bool pair_held = held != manifolds_.end() && held->part_a == pair.a && held->part_b == pair.b;
         for (int q = 0; q < probe.point_count && !unseen; ++q) {
-          const ManifoldPoint& p = probe.points[q];
+          const NarrowPoint& p = probe.points[q];
           bool point_held = false;
           for (int h = 0; pair_held && h < held->point_count; ++h) point_held = point_held || held->points[h].id == p.id;
           if (point_held) continue;
@@ -475,7 +475,7 @@ Aabb NativeEngine::reach_box(std::int32_t k, double reach) const {
   return {parts_.boxes()[k].lo - Vec2{fat, fat}, parts_.boxes()[k].hi + Vec2{fat, fat}};
 }
 
-void NativeEngine::collide_parts(PartPair pair, double reach_a, double reach_b, Manifold& m,
+void NativeEngine::collide_parts(PartPair pair, double reach_a, double reach_b, NarrowManifold& m,
                                  SeparationHint* hint) const {
   // Contacts within both parts' reach this step (speculative), plus the allowed overlap; the
   // reference face kept unless the other is better by a tenth of it.
@@ -526,7 +526,7 @@ void NativeEngine::collide_pairs() {
     std::size_t found = 0;
     for (std::size_t k = begin; k < end; ++k) {
       if (may_reuse && reuse_[k] >= 0) {
-        const Manifold& was = previous_narrow_[static_cast<std::size_t>(reuse_[k])];
+        const NarrowManifold& was = previous_narrow_[static_cast<std::size_t>(reuse_[k])];
         // A pair without contact is read for its point count alone (most pairs of fat boxes).
         if (was.point_count == 0)
           narrow_[k].point_count = 0;
@@ -537,9 +537,9 @@ void NativeEngine::collide_pairs() {
       }
       const PartPair pair = pairs_[k];
       // Every field the solver reads is set here or by collide() (which sets the face and
-      // each point it adds in full); a slot is not cleared first (a Manifold is ~400 bytes,
+      // each point it adds in full); a slot is not cleared first (a NarrowManifold is 192 bytes,
       // and most pairs of fat boxes have no contact).
-      Manifold& m = narrow_[k];
+      NarrowManifold& m = narrow_[k];
       m.part_a = pair.a;
       m.part_b = pair.b;
       m.body_a = parts_.body()[pair.a];
@@ -572,10 +572,10 @@ void NativeEngine::build_contact_list() {
     auto old = static_cast<std::size_t>(find_pair(previous_manifolds_, pairs_[begin]) - previous_manifolds_.begin());
     for (std::size_t k = begin; k < end; ++k) {
       const PartPair pair = pairs_[k];
-      const Manifold& found = narrow_[k];  // narrow_ keeps the narrow phase's own result (reuse)
+      const NarrowManifold& found = narrow_[k];  // narrow_ keeps the narrow phase's own result (reuse)
       if (found.point_count == 0) continue;
       Manifold& m = manifolds_[slot++];
-      copy_manifold(found, m);
+      fill_manifold(found, m);
       // Read from the narrow phase's slot, not the fresh copy: a load from a block just copied
       // waits for the copy's stores to retire.
       while (old < previous_manifolds_.size() &&

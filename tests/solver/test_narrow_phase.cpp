@@ -304,73 +304,129 @@ TEST_CASE("narrow phase: pairs of floes at rest reuse their manifolds to the bit
   }
 }
 
+namespace {
+
+// A manifold with every field set from `base` (each point's fields offset by 100 more) and the
+// flags to `flag`: two of them with other bases differ in every field.
+Manifold filled_manifold(double base, bool flag) {
+  const auto id = static_cast<std::int32_t>(base);
+  Manifold m;
+  m.part_a = id + 1;
+  m.part_b = id + 2;
+  m.body_a = id + 3;
+  m.body_b = id + 4;
+  m.normal = {base, base + 1};
+  for (ManifoldPoint& p : m.points) {
+    p.point = {base + 2, base + 3};
+    p.separation = base + 4;
+    p.id = static_cast<std::uint32_t>(base) + 5;
+    p.local_incident = {base + 6, base + 7};
+    p.normal_impulse = base + 8;
+    p.tangent_impulse = base + 9;
+    p.approach_velocity = base + 10;
+    p.target_velocity = base + 11;
+    p.kind = flag ? ContactKind::collision : ContactKind::resting;
+    p.persistent = flag;
+    p.ra = {base + 12, base + 13};
+    p.rb = {base + 14, base + 15};
+    p.wnn = base + 16;
+    p.wnt = base + 17;
+    p.wtt = base + 18;
+    base += 100;
+  }
+  m.reference_is_b = flag;
+  m.local_normal = {base + 19, base + 20};
+  m.local_face_point = {base + 21, base + 22};
+  m.friction = base + 23;
+  m.restitution = base + 24;
+  return m;
+}
+
+bool same_vec(Vec2 a, Vec2 b) { return same_bits(a.x, b.x) && same_bits(a.y, b.y); }
+
+bool same_point(const ManifoldPoint& a, const ManifoldPoint& b) {
+  return same_vec(a.point, b.point) && same_bits(a.separation, b.separation) && a.id == b.id &&
+         same_vec(a.local_incident, b.local_incident) && same_bits(a.normal_impulse, b.normal_impulse) &&
+         same_bits(a.tangent_impulse, b.tangent_impulse) && same_bits(a.approach_velocity, b.approach_velocity) &&
+         same_bits(a.target_velocity, b.target_velocity) && a.kind == b.kind && a.persistent == b.persistent &&
+         same_vec(a.ra, b.ra) && same_vec(a.rb, b.rb) && same_bits(a.wnn, b.wnn) && same_bits(a.wnt, b.wnt) &&
+         same_bits(a.wtt, b.wtt);
+}
+
+// `to` holds every field of `from` and its points up to from.point_count; a second point past
+// the count is `untouched`.
+void check_copied(const Manifold& to, const Manifold& from, const ManifoldPoint& untouched) {
+  CHECK(to.part_a == from.part_a);
+  CHECK(to.part_b == from.part_b);
+  CHECK(to.body_a == from.body_a);
+  CHECK(to.body_b == from.body_b);
+  CHECK(same_vec(to.normal, from.normal));
+  CHECK(to.point_count == from.point_count);
+  CHECK(same_point(to.points[0], from.points[0]));
+  CHECK(same_point(to.points[1], from.point_count == 2 ? from.points[1] : untouched));
+  CHECK(to.reference_is_b == from.reference_is_b);
+  CHECK(same_vec(to.local_normal, from.local_normal));
+  CHECK(same_vec(to.local_face_point, from.local_face_point));
+  CHECK(same_bits(to.friction, from.friction));
+  CHECK(same_bits(to.restitution, from.restitution));
+}
+
+}  // namespace
+
 TEST_CASE("copy_manifold copies every field a contact holds and leaves an unused point as it was") {
   // The contact list is built with copy_manifold (byte ranges, not the whole struct): a field
   // it missed would reach the solver stale. Every field of the source and of the target set to
   // values that differ between the two (flags included), so a field not copied fails its check.
-  auto filled = [](double base, bool flag) {
-    const auto id = static_cast<std::int32_t>(base);
-    Manifold m;
-    m.part_a = id + 1;
-    m.part_b = id + 2;
-    m.body_a = id + 3;
-    m.body_b = id + 4;
-    m.normal = {base, base + 1};
-    for (ManifoldPoint& p : m.points) {
-      p.point = {base + 2, base + 3};
-      p.separation = base + 4;
-      p.id = static_cast<std::uint32_t>(base) + 5;
-      p.local_incident = {base + 6, base + 7};
-      p.normal_impulse = base + 8;
-      p.tangent_impulse = base + 9;
-      p.approach_velocity = base + 10;
-      p.target_velocity = base + 11;
-      p.kind = flag ? ContactKind::collision : ContactKind::resting;
-      p.persistent = flag;
-      p.ra = {base + 12, base + 13};
-      p.rb = {base + 14, base + 15};
-      p.wnn = base + 16;
-      p.wnt = base + 17;
-      p.wtt = base + 18;
-      base += 100;
-    }
-    m.reference_is_b = flag;
-    m.local_normal = {base + 19, base + 20};
-    m.local_face_point = {base + 21, base + 22};
-    m.friction = base + 23;
-    m.restitution = base + 24;
-    return m;
-  };
-  auto same_vec = [](Vec2 a, Vec2 b) { return same_bits(a.x, b.x) && same_bits(a.y, b.y); };
-  auto same_point = [&](const ManifoldPoint& a, const ManifoldPoint& b) {
-    return same_vec(a.point, b.point) && same_bits(a.separation, b.separation) && a.id == b.id &&
-           same_vec(a.local_incident, b.local_incident) && same_bits(a.normal_impulse, b.normal_impulse) &&
-           same_bits(a.tangent_impulse, b.tangent_impulse) && same_bits(a.approach_velocity, b.approach_velocity) &&
-           same_bits(a.target_velocity, b.target_velocity) && a.kind == b.kind && a.persistent == b.persistent &&
-           same_vec(a.ra, b.ra) && same_vec(a.rb, b.rb) && same_bits(a.wnn, b.wnn) && same_bits(a.wnt, b.wnt) &&
-           same_bits(a.wtt, b.wtt);
-  };
   for (const int count : {1, 2}) {
-    Manifold from = filled(1000.0, true);
+    Manifold from = filled_manifold(1000.0, true);
     from.point_count = count;
-    Manifold to = filled(5000.0, false);
+    Manifold to = filled_manifold(5000.0, false);
     const ManifoldPoint untouched = to.points[1];
     copy_manifold(from, to);
-    CHECK(to.part_a == from.part_a);
-    CHECK(to.part_b == from.part_b);
-    CHECK(to.body_a == from.body_a);
-    CHECK(to.body_b == from.body_b);
-    CHECK(same_bits(to.normal.x, from.normal.x));
-    CHECK(same_bits(to.normal.y, from.normal.y));
-    CHECK(to.point_count == count);
-    CHECK(same_point(to.points[0], from.points[0]));
-    CHECK(same_point(to.points[1], count == 2 ? from.points[1] : untouched));
-    CHECK(to.reference_is_b == from.reference_is_b);
-    CHECK(same_bits(to.local_normal.x, from.local_normal.x));
-    CHECK(same_bits(to.local_normal.y, from.local_normal.y));
-    CHECK(same_bits(to.local_face_point.x, from.local_face_point.x));
-    CHECK(same_bits(to.local_face_point.y, from.local_face_point.y));
-    CHECK(same_bits(to.friction, from.friction));
-    CHECK(same_bits(to.restitution, from.restitution));
+    check_copied(to, from, untouched);
+  }
+}
+
+TEST_CASE("fill_manifold makes the contact list's manifold from the narrow phase's, every field, solver fields fresh") {
+  // The narrow phase keeps NarrowManifold (the fields it finds); the contact list fills a
+  // Manifold from it: each field copied, each point's solver fields as a fresh ManifoldPoint has
+  // them, a point past the count left as it was. A field missed would reach the solver stale.
+  const Manifold source = filled_manifold(1000.0, true);
+  NarrowManifold from;
+  from.part_a = source.part_a;
+  from.part_b = source.part_b;
+  from.body_a = source.body_a;
+  from.body_b = source.body_b;
+  from.normal = source.normal;
+  for (int k = 0; k < 2; ++k) {
+    from.points[k].point = source.points[k].point;
+    from.points[k].separation = source.points[k].separation;
+    from.points[k].id = source.points[k].id;
+    from.points[k].local_incident = source.points[k].local_incident;
+  }
+  from.reference_is_b = source.reference_is_b;
+  from.local_normal = source.local_normal;
+  from.local_face_point = source.local_face_point;
+  from.friction = source.friction;
+  from.restitution = source.restitution;
+  for (const int count : {1, 2}) {
+    from.point_count = count;
+    Manifold expected = source;  // what collide() writes into a Manifold
+    expected.point_count = count;
+    for (ManifoldPoint& p : expected.points) {
+      const ManifoldPoint found = p;
+      p = ManifoldPoint{};
+      p.point = found.point;
+      p.separation = found.separation;
+      p.id = found.id;
+      p.local_incident = found.local_incident;
+    }
+    Manifold to = filled_manifold(5000.0, false);
+    const ManifoldPoint untouched = to.points[1];
+    fill_manifold(from, to);
+    check_copied(to, expected, untouched);
+    CHECK(to.points[0].normal_impulse == 0.0);
+    CHECK(!to.points[0].persistent);
+    CHECK(to.points[0].kind == ContactKind::resting);
   }
 }
