@@ -27,20 +27,6 @@ struct ManifoldPoint {
   double wnn = 0.0, wnt = 0.0, wtt = 0.0;  ///< Delassus block n.M^-1 n etc. (see contact_solver.cpp)
 };
 
-struct Manifold {
-  std::int32_t part_a = 0, part_b = 0;   ///< part_a < part_b
-  std::int32_t body_a = 0, body_b = 0;   ///< body_a < body_b
-  Vec2 normal;                           ///< world, unit, from a to b
-  int point_count = 0;
-  ManifoldPoint points[2];
-  // Reference face in its body's frame, for the position solve.
-  bool reference_is_b = false;
-  Vec2 local_normal;      ///< outward normal of the reference face
-  Vec2 local_face_point;  ///< a vertex of the reference face
-  double friction = 0.0;
-  double restitution = 0.0;
-};
-
 /// What the narrow phase finds at a point: ManifoldPoint's fields before the solver's.
 struct NarrowPoint {
   Vec2 point;               ///< world, midway between the two surfaces
@@ -49,22 +35,30 @@ struct NarrowPoint {
   Vec2 local_incident;      ///< the incident polygon's point, in its body's frame
 };
 
-/// What the narrow phase finds for a pair: Manifold's fields without the solver's (impulses,
-/// lever arms, Delassus blocks, targets), 192 bytes against 384. The narrow phase writes one per
-/// pair every step (about 37 000 at 16k floes, packed) and the contact list reads them back:
-/// at the full size, that traffic alone filled the 1 MB L2 many times a step.
-struct NarrowManifold {
-  std::int32_t part_a = 0, part_b = 0;
-  std::int32_t body_a = 0, body_b = 0;
-  Vec2 normal;
+/// A pair's contact: up to two points of type Point and what they share. The solver's
+/// (Manifold, below) and the narrow phase's (NarrowManifold) are this one list of fields.
+template <class Point>
+struct BasicManifold {
+  std::int32_t part_a = 0, part_b = 0;   ///< part_a < part_b
+  std::int32_t body_a = 0, body_b = 0;   ///< body_a < body_b
+  Vec2 normal;                           ///< world, unit, from a to b
   int point_count = 0;
-  NarrowPoint points[2];
+  Point points[2];
+  // Reference face in its body's frame, for the position solve.
   bool reference_is_b = false;
-  Vec2 local_normal;
-  Vec2 local_face_point;
+  Vec2 local_normal;      ///< outward normal of the reference face
+  Vec2 local_face_point;  ///< a vertex of the reference face
   double friction = 0.0;
   double restitution = 0.0;
 };
+
+using Manifold = BasicManifold<ManifoldPoint>;
+
+/// What the narrow phase finds for a pair: Manifold without the solver's fields of each point
+/// (impulses, lever arms, Delassus blocks, targets), 192 bytes against 384. The narrow phase
+/// writes one per pair every step (about 37 000 at 16k floes, packed) and the contact list
+/// reads them back: at the full size, that traffic alone filled the 1 MB L2 many times a step.
+using NarrowManifold = BasicManifold<NarrowPoint>;
 
 /// Copies what `from` holds into `to`: every field but the points past point_count, which are
 /// left as they were (nothing reads them). Byte ranges, not a list of fields, so a field added

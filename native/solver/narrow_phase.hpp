@@ -27,10 +27,10 @@ struct PartGeometry {
 /// needs: a floe sliding corner-first onto another's face within the step).
 /// `hint` (optional, kept per pair by the caller): the edges to test first, updated to this
 /// test's; the manifold is the same with or without it, to the bit.
-/// The same into the narrow phase's compact manifold (NarrowManifold, what the engine keeps per
-/// pair): the same fields, the same values to the bit.
 void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m,
              SeparationHint* hint = nullptr);
+/// The same into the narrow phase's compact manifold (NarrowManifold, what the engine keeps per
+/// pair): the same fields, the same values to the bit.
 void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance,
              NarrowManifold& m, SeparationHint* hint = nullptr);
 

@@ -55,11 +55,9 @@ class NativeEngine final : public Engine {
   void pair_up();  // parts placed at the bodies' positions (unchanged within a step)
   bool outran_reach();
   bool meets_unseen_contact();
-  void build_manifolds() {
-    collide_pairs();
-    build_contact_list();
-  }
-  void collide_pairs();       // the narrow phase: each pair's manifold into narrow_
+  // The narrow phase: each pair's manifold into narrow_; `redetection`: that of a step found
+  // again (every part where the step's first narrow phase had it).
+  void collide_pairs(bool redetection);
   void build_contact_list();  // narrow_'s contacts into manifolds_, warm-started and classified
   void apply_loads(const Loads& loads);
   void integrate();
@@ -115,7 +113,6 @@ class NativeEngine final : public Engine {
   // position and rotation the same to the bit) with the same reaches gets the manifold computed
   // last time, not a new one. In the towing case most pairs are of floes at rest.
   bool any_kept_ = false;                  // any part kept (else no reuse is looked for: a drifting field)
-  bool redetecting_ = false;               // the narrow phase of a redetection (every part where it was)
   std::vector<NarrowManifold> previous_narrow_;  // the last narrow phase's results ...
   std::vector<PartPair> previous_pairs_;   // ... for these pairs ...
   std::vector<double> previous_reach_;     // ... with these part reaches
@@ -324,7 +321,7 @@ void NativeEngine::step(const Loads* loads) {
   // 1. pairs (a velocity turn keeps the speed)
   stages_.time(kBroad, [&] { find_pairs(loads && loads->any ? loads : nullptr); });
   // 2. manifolds, classified on the velocities before the step
-  stages_.time(kNarrow, [&] { collide_pairs(); });
+  stages_.time(kNarrow, [&] { collide_pairs(/*redetection=*/false); });
   stages_.time(kContactList, [&] { build_contact_list(); });
   if (loads) stages_.time(kLoads, [&] { apply_loads(*loads); });  // 3. non-contact forces
   if (!manifolds_.empty()) {                                       // 4. contact impulses
@@ -344,9 +341,8 @@ void NativeEngine::step(const Loads* loads) {
         apply_accumulated_impulses(manifolds_, bodies_, -1.0);
         std::swap(manifolds_, previous_manifolds_);  // last step's manifolds again, for the warm start
         pair_up();
-        redetecting_ = true;
-        build_manifolds();
-        redetecting_ = false;
+        collide_pairs(/*redetection=*/true);
+        build_contact_list();
         solve_contacts();
         ++redetections_;
       }
@@ -488,7 +484,7 @@ PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
   return parts_.geometry(k, bodies_.position[b], bodies_.rotation[b]);
 }
 
-void NativeEngine::collide_pairs() {
+void NativeEngine::collide_pairs(bool redetection) {
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
   narrow_.resize(pairs_.size());
@@ -497,7 +493,7 @@ void NativeEngine::collide_pairs() {
   // A redetection's narrow phase follows the step's first one with every part where it was
   // (only the reaches of the bodies that outran theirs grew): each pair of parts whose reaches
   // stayed the same gets the first one's manifold.
-  const bool may_reuse = (any_kept_ || redetecting_) && !previous_pairs_.empty();
+  const bool may_reuse = (any_kept_ || redetection) && !previous_pairs_.empty();
   if (may_reuse) resize_with_headroom(reuse_, pairs_.size());
   resize_with_headroom(narrow_hint_, pairs_.size());
   auto same_reach = [&](std::int32_t part) {
@@ -511,7 +507,7 @@ void NativeEngine::collide_pairs() {
     narrow_hint_[k] = met ? previous_hint_[last] : SeparationHint{};
     if (!may_reuse) continue;
     reuse_[k] = -1;
-    if (met && (redetecting_ || (parts_.kept()[pair.a] && parts_.kept()[pair.b])) && same_reach(pair.a) &&
+    if (met && (redetection || (parts_.kept()[pair.a] && parts_.kept()[pair.b])) && same_reach(pair.a) &&
         same_reach(pair.b)) {
       reuse_[k] = static_cast<std::int32_t>(last);
       ++narrow_reused_;
