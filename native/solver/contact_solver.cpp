@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "solver/coloured_sweeps.hpp"
 #include "solver/headroom.hpp"
 #include "solver/sweep_pipeline.hpp"
 #include "solver/sweep_row.hpp"
@@ -107,7 +108,7 @@ void apply_accumulated_impulses(std::span<const Manifold> manifolds, BodyArrays&
 // |P_t| > mu P_n) is brought back by the next sweep; the solve always ends on a sweep, never on
 // a step, so its impulses keep their laws.
 namespace {
-constexpr int kCheckEvery = 10;
+constexpr int kCheckEvery = SweepLimits::check_every;
 
 // The manifolds a solve runs over: all of a span, or an island's (indices into it, in order).
 struct AllRows {
@@ -263,7 +264,7 @@ double largest_shortfall(std::span<const Manifold> manifolds, const BodyArrays& 
   return worst;
 }
 
-void SweepWork::reserve(std::size_t manifolds, bool accelerate) {
+void SweepWork::reserve(std::size_t manifolds, bool accelerate, std::size_t colour_bodies, std::size_t bundles) {
   // Half as many again when it grows: no allocation each time a pack gains a contact.
   auto grow = [](auto& v, std::size_t n) {
     if (v.size() < n) v.resize(n + n / 2);
@@ -274,24 +275,36 @@ void SweepWork::reserve(std::size_t manifolds, bool accelerate) {
     grow(direction_, 4 * manifolds);
     grow(step_, 4 * manifolds);
   }
+  if (colour_bodies > 0) {
+    grow(bundles_, bundles);
+    grow(overflow_, manifolds);
+    if (body_colours_.size() < colour_bodies) body_colours_.resize(colour_bodies, 0);  // zero, and kept zero by each solve
+  }
 }
 
-SweepSpace SweepWork::slice(std::size_t first, std::size_t count) {
+SweepSpace SweepWork::slice(std::size_t first, std::size_t count, std::size_t bundle_first, std::size_t bundle_count) {
   auto part = [](auto& v, std::size_t at, std::size_t n) {
     using T = typename std::remove_reference_t<decltype(v)>::value_type;
     return v.size() >= at + n ? std::span<T>(v).subspan(at, n) : std::span<T>();
   };
-  return {part(rows_, 2 * first, 2 * count), part(change_, 4 * first, 4 * count),
-          part(direction_, 4 * first, 4 * count), part(step_, 4 * first, 4 * count)};
+  return {part(rows_, 2 * first, 2 * count),
+          part(change_, 4 * first, 4 * count),
+          part(direction_, 4 * first, 4 * count),
+          part(step_, 4 * first, 4 * count),
+          part(bundles_, bundle_first, bundle_count),
+          part(overflow_, first, count),
+          std::span<std::uint64_t>(body_colours_)};
 }
 
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepSpace space,
                      SweepOptions options) {
+  if (options.colour) return solve_coloured(manifolds, {}, s, limits, space, options.warm_start, options.accelerate);
   return solve_rows(AllRows{manifolds}, s, limits, space, options);
 }
 
 int solve_velocities(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& s,
                      const SweepLimits& limits, SweepSpace space, SweepOptions options) {
+  if (options.colour) return solve_coloured(manifolds, island, s, limits, space, options.warm_start, options.accelerate);
   return solve_rows(IslandRows{manifolds, island}, s, limits, space, options);
 }
 

@@ -7,6 +7,7 @@
 
 #include "solver/contact_types.hpp"
 #include "solver/native_settings.hpp"
+#include "solver/sweep_bundle.hpp"
 
 namespace floedem {
 
@@ -74,6 +75,15 @@ struct SweepSpace {
   std::span<double> change;     ///< per row (n, t): the impulse change of the last sweep
   std::span<double> direction;  ///< per row (n, t): the conjugate direction p
   std::span<double> step;       ///< per row (n, t): beta p, the impulse the step adds
+  /// For the coloured sweeps (SweepOptions::colour, coloured_sweeps.hpp): room for the
+  /// solve's bundles (bundles_for(manifolds) at most); per manifold, room for the list of those
+  /// beyond the 63 colours, swept as rows (in `rows`); and per body (the whole scene's, by body
+  /// id) the colours its manifolds took so far, all zero between solves: islands share no
+  /// moving body, so islands solved side by side write disjoint entries of it. The NNCG arrays
+  /// above serve it too (per manifold: point, n or t).
+  std::span<SweepBundle> bundles;
+  std::span<std::int32_t> overflow;
+  std::span<std::uint64_t> body_colours;
 };
 
 /// The storage behind SweepSpaces, kept by the caller (no allocation per step once sized).
@@ -81,22 +91,30 @@ class SweepWork {
  public:
   /// Makes room for `manifolds` manifolds (rows; the accelerated sweeps' arrays too with
   /// `accelerate`), keeping what is there: a slice handed out before stays valid until the next call.
-  void reserve(std::size_t manifolds, bool accelerate);
-  /// The space of the manifolds [first, first + count) of what reserve() made room for.
-  SweepSpace slice(std::size_t first, std::size_t count);
-  /// reserve(manifolds, accelerate) and the whole of it.
-  SweepSpace space(std::size_t manifolds, bool accelerate) {
-    reserve(manifolds, accelerate);
-    return slice(0, manifolds);
+  /// With `colour_bodies` > 0, room for the coloured sweeps too, for a scene of that many
+  /// bodies, with `bundles` bundles in all (bundles_for(manifolds) for one solve of them all).
+  void reserve(std::size_t manifolds, bool accelerate, std::size_t colour_bodies = 0, std::size_t bundles = 0);
+  /// The space of the manifolds [first, first + count) of what reserve() made room for, with
+  /// the bundles [bundle_first, bundle_first + bundle_count).
+  SweepSpace slice(std::size_t first, std::size_t count, std::size_t bundle_first = 0, std::size_t bundle_count = 0);
+  /// Room for one solve of `manifolds` manifolds, and the whole of it.
+  SweepSpace space(std::size_t manifolds, bool accelerate, std::size_t colour_bodies = 0) {
+    const std::size_t bundles = colour_bodies > 0 ? bundles_for(manifolds) : 0;
+    reserve(manifolds, accelerate, colour_bodies, bundles);
+    return slice(0, manifolds, 0, bundles);
   }
 
  private:
   std::vector<SweepRow> rows_;
   std::vector<double> change_, direction_, step_;
+  std::vector<SweepBundle> bundles_;
+  std::vector<std::int32_t> overflow_;
+  std::vector<std::uint64_t> body_colours_;
 };
 
 /// How long the sweeps go on.
 struct SweepLimits {
+  static constexpr int check_every = 10;  ///< past `iterations`, sweeps between looks at what is left closing
   int iterations = 50;         ///< sweeps made at most, unless a point is left closing (below)
   double tolerance = 1e-10;    ///< stop once no impulse changes by more than this times the largest
   int extra_iterations = 0;    ///< more sweeps, made only while ...
@@ -117,6 +135,10 @@ struct SweepOptions {
   /// Plain sweeps (without `accelerate`) of enough rows on the pool's threads, the same to the
   /// bit (sweep_pipeline.hpp). Not from inside a loop of the pool.
   SweepPipeline* pipeline = nullptr;
+  /// Sweep the manifolds colour by colour, four at a time (coloured_sweeps.hpp), instead of in
+  /// the order given: another Gauss-Seidel order, so other impulses after a given number of
+  /// sweeps. Needs the space's coloured arrays; `pipeline` is not used.
+  bool colour = false;
 };
 /// `space` must hold manifolds.size() manifolds (and their accelerated arrays with `accelerate`).
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, const SweepLimits& limits, SweepSpace space,

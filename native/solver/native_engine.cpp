@@ -146,6 +146,7 @@ class NativeEngine final : public Engine {
   std::vector<Vec2> island_velocity_;
   std::vector<double> island_angular_velocity_;
   SweepWork sweep_work_;  // the islands' sweeps, each in its slice (its manifolds' place in islands_)
+  std::vector<std::size_t> island_bundles_;  // coloured sweeps: each island's first bundle in sweep_work_
   SweepPipeline sweep_pipeline_;  // the plain sweeps of the largest islands, on every thread
   static constexpr std::size_t kIslandGrain = 8;  // islands per block
   static constexpr std::size_t kPairGrain = 512;  // pairs per block (narrow phase, contact list)
@@ -211,6 +212,7 @@ EngineInfo NativeEngine::info() const {
       {"velocity_iterations", std::to_string(settings_.velocity_iterations)},
       {"extra_iterations", std::to_string(settings_.extra_iterations)},
       {"accelerate", settings_.accelerate ? "true" : "false"},
+      {"coloured_sweeps", settings_.coloured_sweeps ? "true" : "false"},
       {"tolerance", setting_text(settings_.tolerance)},
       {"warm_start", settings_.warm_start ? "true" : "false"},
       {"position_iterations", std::to_string(settings_.position_iterations)},
@@ -623,7 +625,14 @@ void NativeEngine::solve_contacts() {
   const std::size_t n = islands_.size();
   const std::size_t blocks = std::max<std::size_t>(1, (n + kIslandGrain - 1) / kIslandGrain);
   if (island_work_.size() < blocks) island_work_.resize(blocks + blocks / 2);
-  sweep_work_.reserve(manifolds_.size(), settings_.accelerate);
+  if (settings_.coloured_sweeps) {
+    // Each island's bundles in a slice of their own, sized for its manifolds (bundles_for).
+    resize_with_headroom(island_bundles_, n + 1);
+    island_bundles_[0] = 0;
+    for (std::size_t i = 0; i < n; ++i) island_bundles_[i + 1] = island_bundles_[i] + bundles_for(islands_.manifolds(i).size());
+  }
+  sweep_work_.reserve(manifolds_.size(), settings_.accelerate, settings_.coloured_sweeps ? bodies_.inv_mass.size() : 0,
+                      settings_.coloured_sweeps ? island_bundles_[n] : 0);
   if (checked) {
     resize_with_headroom(island_velocity_, islands_.body_count());
     resize_with_headroom(island_angular_velocity_, islands_.body_count());
@@ -633,7 +642,7 @@ void NativeEngine::solve_contacts() {
   // is left out of the blocks and solved after them on every thread at once, its plain sweeps
   // pipelined (sweep_pipeline.hpp): on two threads, the rest of the islands and it would
   // otherwise wait for the one thread that has it.
-  const bool pipelined = !settings_.accelerate && thread_pool().size() > 1;
+  const bool pipelined = !settings_.accelerate && !settings_.coloured_sweeps && thread_pool().size() > 1;
   auto large = [&](std::size_t i) {
     return pipelined && SweepPipeline::parts_for(2 * islands_.manifolds(i).size()) > 1;
   };
@@ -681,9 +690,16 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
       island_angular_velocity_[at + x] = bodies_.angular_velocity[bodies[x]];
     }
   }
-  const SweepSpace space = sweep_work_.slice(islands_.manifold_offset(island), manifolds.size());
+  const SweepSpace space =
+      settings_.coloured_sweeps
+          ? sweep_work_.slice(islands_.manifold_offset(island), manifolds.size(), island_bundles_[island],
+                              island_bundles_[island + 1] - island_bundles_[island])
+          : sweep_work_.slice(islands_.manifold_offset(island), manifolds.size());
   int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,
-                                {.warm_start = settings_.warm_start, .accelerate = settings_.accelerate, .pipeline = pipeline});
+                                {.warm_start = settings_.warm_start,
+                                 .accelerate = settings_.accelerate,
+                                 .pipeline = pipeline,
+                                 .colour = settings_.coloured_sweeps});
   if (!checked) return sweeps;
   double pushed = 0.0;  // the work of towed bodies on this island's floes (contacts_gain_energy)
   if (has_prescribed_)
@@ -698,7 +714,7 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
     for (int j = 0; j < m.point_count; ++j) m.points[j].normal_impulse = m.points[j].tangent_impulse = 0.0;
   }
   sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,  // plain sweeps: no energy made
-                             {.pipeline = pipeline});
+                             {.pipeline = pipeline, .colour = settings_.coloured_sweeps});
   ++work.cold_restarts;
   return sweeps;
 }

@@ -10,6 +10,7 @@ struct NativeSettings {
   double tolerance = 1e-10;          ///< stop sweeping when max |dP| <= tolerance * max |P|
   bool warm_start = true;            ///< start from last step's resting impulses
   bool accelerate = true;            ///< conjugate-gradient step after each sweep (NNCG)
+  bool coloured_sweeps = false;      ///< sweep the contacts colour by colour (graph colouring), not in pair order
   int position_iterations = 4;       ///< position-projection sweeps per step (0: none)
   double position_correction = 0.2;  ///< fraction of the overlap removed per sweep
   double allowed_penetration = 1e-3; ///< m, overlap left alone (keeps contacts persistent)

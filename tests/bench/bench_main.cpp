@@ -254,8 +254,9 @@ const PackedField& packed_field() {
 
 /// One step's contact sweeps on the packed field, timed: the warm start and 10 plain
 /// Gauss-Seidel sweeps (the speed benchmark's settings), from the same impulses and velocities
-/// each time; pipelined over the pool's threads with `pipeline`. Returns the contact points.
-std::size_t time_contact_sweeps(benchmark::State& state, SweepPipeline* pipeline) {
+/// each time; pipelined over the pool's threads with `pipeline`, or in colour order four
+/// manifolds at a time with `colour` (coloured_sweeps.hpp). Returns the contact points.
+std::size_t time_contact_sweeps(benchmark::State& state, SweepPipeline* pipeline, bool colour = false) {
   const PackedField& field = packed_field();
   std::vector<Manifold> manifolds = field.manifolds;
   BodyArrays bodies = field.bodies;
@@ -269,8 +270,9 @@ std::size_t time_contact_sweeps(benchmark::State& state, SweepPipeline* pipeline
     bodies.velocity = field.bodies.velocity;
     bodies.angular_velocity = field.bodies.angular_velocity;
     state.ResumeTiming();
-    sweeps = solve_velocities(manifolds, bodies, field.limits, work.space(manifolds.size(), false),
-                              {.warm_start = true, .pipeline = pipeline});
+    sweeps = solve_velocities(manifolds, bodies, field.limits,
+                              work.space(manifolds.size(), false, colour ? bodies.inv_mass.size() : 0),
+                              {.warm_start = true, .pipeline = pipeline, .colour = colour});
     benchmark::DoNotOptimize(bodies.velocity.data());
   }
   state.counters["manifolds"] = static_cast<double>(manifolds.size());
@@ -284,6 +286,10 @@ std::size_t time_contact_sweeps(benchmark::State& state, SweepPipeline* pipeline
 /// The sweeps on one thread. ns_per_point_sweep: the cost of one point's local solve.
 void BM_ContactSweeps(benchmark::State& state) { time_contact_sweeps(state, nullptr); }
 BENCHMARK(BM_ContactSweeps)->Unit(benchmark::kMicrosecond);
+
+/// The sweeps in colour order, four manifolds at a time (`coloured_sweeps`), on one thread.
+void BM_ContactSweepsColoured(benchmark::State& state) { time_contact_sweeps(state, nullptr, true); }
+BENCHMARK(BM_ContactSweepsColoured)->Unit(benchmark::kMicrosecond);
 
 /// The same sweeps pipelined over a pool of state.range(0) threads (sweep_pipeline.hpp): the
 /// same impulses to the bit, in wall time (on a machine with fewer cores than threads, the

@@ -1,0 +1,496 @@
+#include "solver/coloured_sweeps.hpp"
+
+#include "solver/sweep_row.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+#include "solver/sweep_row.hpp"
+
+// The conditions each point's local solve meets, and the Delassus block, are stated in
+// contact_solver.cpp; the case-by-case solve is local_impulse (sweep_row.hpp), of which
+// local_lanes below is the same arithmetic with every case computed and the first that holds
+// selected.
+
+namespace floedem {
+
+namespace {
+
+// Four doubles in one vector (GCC and Clang vector extensions): two SSE2 registers on the
+// x86-64 baseline, one AVX register in the AVX2 build of the sweep (sweep_avx2 below). Masks
+// are 64-bit lanes of all ones (true) or zeros.
+using v4d = double __attribute__((vector_size(8 * kBundleLanes)));
+using v4m = std::int64_t __attribute__((vector_size(8 * kBundleLanes)));
+
+#define FLOEDEM_LANES [[gnu::always_inline]] inline
+
+FLOEDEM_LANES v4d load(const double* p) {
+  v4d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+FLOEDEM_LANES void store(double* p, v4d v) { std::memcpy(p, &v, sizeof v); }
+FLOEDEM_LANES v4d splat(double x) { return v4d{} + x; }
+// Per lane: a where the mask holds, else b.
+FLOEDEM_LANES v4d select(v4m m, v4d a, v4d b) { return (v4d)((m & (v4m)a) | (~m & (v4m)b)); }
+FLOEDEM_LANES v4d abs(v4d x) {
+  constexpr std::int64_t magnitude = std::numeric_limits<std::int64_t>::max();
+  return (v4d)((v4m)x & magnitude);
+}
+// std::max(a, b) per lane: (a < b) ? b : a.
+FLOEDEM_LANES v4d max(v4d a, v4d b) { return select((v4m)(a < b), b, a); }
+
+// The velocities of the bundle's bodies on one side, held in registers over its points.
+struct Side {
+  v4d vx, vy, w;
+};
+
+// Four lanes from four places, as two pairs joined: built as v4d{a, b, c, d}, GCC loads each
+// lane into the register that held the previous bundle's vector (vmovlpd merges), which chains
+// every bundle to the one before it and leaves the sweep one bundle at a time.
+using v2d = double __attribute__((vector_size(16)));
+FLOEDEM_LANES v4d lanes(double a, double b, double c, double d) {
+  const v2d low{a, b}, high{c, d};
+  return __builtin_shufflevector(low, high, 0, 1, 2, 3);
+}
+FLOEDEM_LANES Side gather(const std::int32_t* body, const Vec2* v, const double* w) {
+  static_assert(kBundleLanes == 4);
+  return {lanes(v[body[0]].x, v[body[1]].x, v[body[2]].x, v[body[3]].x),
+          lanes(v[body[0]].y, v[body[1]].y, v[body[2]].y, v[body[3]].y),
+          lanes(w[body[0]], w[body[1]], w[body[2]], w[body[3]])};
+}
+
+// Writes back the lanes whose body moves (as apply_impulse: a fixed or towed body, and an
+// empty lane, is never written; the same fixed body may be read by islands on other threads).
+FLOEDEM_LANES void scatter(const std::int32_t* body, const double* inv_mass, const Side& s, Vec2* v, double* w) {
+  for (int l = 0; l < kBundleLanes; ++l) {
+    if (inv_mass[l] == 0.0) continue;
+    v[body[l]] = {s.vx[l], s.vy[l]};
+    w[body[l]] = s.w[l];
+  }
+}
+
+// apply_impulse, lane by lane: P = (px, py) on b, -P on a.
+FLOEDEM_LANES void apply(const SweepBundle& b, const BundlePoint& p, v4d px, v4d py, Side& a_side, Side& b_side) {
+  const v4d ma = load(b.ma), ia = load(b.ia), mb = load(b.mb), ib = load(b.ib);
+  a_side.vx = a_side.vx - ma * px;
+  a_side.vy = a_side.vy - ma * py;
+  a_side.w = a_side.w - ia * (load(p.rax) * py - load(p.ray) * px);
+  b_side.vx = b_side.vx + mb * px;
+  b_side.vy = b_side.vy + mb * py;
+  b_side.w = b_side.w + ib * (load(p.rbx) * py - load(p.rby) * px);
+}
+
+// local_impulse (sweep_row.hpp) on four lanes: each case's impulse computed, then the first
+// case that holds, in local_impulse's order, selected. Its divisions are multiplications by
+// the point's reciprocals (fixed for the step): a division's latency, three of them on the
+// chain from one point's velocities to the next's, held the sweep more than its arithmetic.
+FLOEDEM_LANES void local_lanes(const BundlePoint& p, v4d ufn, v4d uft, v4d mu, v4d& pn, v4d& pt) {
+  // Written so that few values are live at once (the Side velocities, the normal and the sweep's
+  // maxima hold most of the sixteen registers of AVX2): each case, from the last to the first,
+  // computed and selected in turn.
+  const v4d zero = splat(0.0), one = splat(1.0);
+  const v4d wnt = load(p.wnt);
+  const v4d need = load(p.target) - ufn;
+  // Neither slide nor stick: the frictionless normal impulse, friction clamped to the cone (std::clamp).
+  pn = need * load(p.inv_wnn);
+  {
+    const v4d want = -(uft + wnt * pn) * load(p.inv_wtt);
+    const v4d cone = mu * pn;
+    pt = select((v4m)(want < -cone), -cone, select((v4m)(cone < want), cone, want));
+  }
+  // Stick: W (P_n, P_t) = (need, -u_t).
+  const v4d inv_det = load(p.inv_det);
+  const v4d pt_stick = (-load(p.wnn) * uft - wnt * need) * inv_det;
+  // Slide with slip direction s: P_t = -s mu P_n, (W_nn - s mu W_nt) P_n = need, consistent if
+  // s u_t+ >= 0 (to rounding). Tried first with s = -1 where stick wanted P_t > 0, else s = +1.
+  const v4m minus_first = (v4m)(pt_stick > zero);
+  const v4d slack = splat(-1e-14) * (abs(uft) + abs(need));
+  auto slide = [&](v4d s, v4d inv_denominator) {
+    const v4d slide_pn = need * inv_denominator;  // NaN where the divisor is not positive: never holds
+    const v4m holds = (v4m)(s * (uft + (wnt - s * mu * load(p.wtt)) * slide_pn) >= slack);
+    pn = select(holds, slide_pn, pn);
+    pt = select(holds, -s * mu * slide_pn, pt);
+  };
+  const v4d plus = load(p.inv_slide_plus), minus = load(p.inv_slide_minus);
+  slide(select(minus_first, one, -one), select(minus_first, plus, minus));  // the second try
+  slide(select(minus_first, -one, one), select(minus_first, minus, plus));  // the first
+  const v4d pn_stick = (load(p.wtt) * need + wnt * uft) * inv_det;
+  const v4m stick = (v4m)(pn_stick >= zero) & (v4m)(abs(pt_stick) <= mu * pn_stick);
+  pn = select(stick, pn_stick, pn);
+  pt = select(stick, pt_stick, pt);
+  const v4m frictionless = (v4m)(mu <= zero);
+  pn = select(frictionless, need * load(p.inv_wnn), pn);
+  pt = select(frictionless, zero, pt);
+  const v4m apart = (v4m)(need <= zero);
+  pn = select(apart, zero, pn);
+  pt = select(apart, zero, pt);
+}
+
+// What a sweep reports: its largest change |dP_n| + |dP_t| and impulse P_n + |P_t| (each
+// lane's, reduced at the end), and |dP|^2 summed (NNCG).
+struct SweepResult {
+  double largest_change = 0.0, largest_impulse = 0.0, size = 0.0;
+};
+
+// One Gauss-Seidel sweep over the bundles, in order; with `change` (NNCG), each point's
+// impulse change into it (4 values a manifold: point, n or t).
+FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
+  v4d largest_change = splat(0.0), largest_impulse = splat(0.0), size = splat(0.0);
+  for (std::size_t i = 0; i < bundles.size(); ++i) {
+    SweepBundle& b = bundles[i];
+    Side a_side = gather(b.body_a, v, w), b_side = gather(b.body_b, v, w);
+    const v4d nx = load(b.nx), ny = load(b.ny), mu = load(b.friction);  // t = perp(n) = (-ny, nx)
+    for (int k = 0; k < b.points; ++k) {
+      BundlePoint& p = b.point[k];
+      // Relative velocity of b's point with respect to a's: (v_b + w_b k x r_b) - (v_a + w_a k x r_a).
+      const v4d ux = (b_side.vx + -b_side.w * load(p.rby)) - (a_side.vx + -a_side.w * load(p.ray));
+      const v4d uy = (b_side.vy + b_side.w * load(p.rbx)) - (a_side.vy + a_side.w * load(p.rax));
+      const v4d pn0 = load(p.normal_impulse), pt0 = load(p.tangent_impulse);
+      // Velocity without this point's own impulse.
+      const v4d ufn = (ux * nx + uy * ny) - (load(p.wnn) * pn0 + load(p.wnt) * pt0);
+      const v4d uft = (ux * -ny + uy * nx) - (load(p.wnt) * pn0 + load(p.wtt) * pt0);
+      v4d pn, pt;
+      local_lanes(p, ufn, uft, mu, pn, pt);
+      const v4d dpn = pn - pn0, dpt = pt - pt0;
+      apply(b, p, dpn * nx + dpt * -ny, dpn * ny + dpt * nx, a_side, b_side);
+      store(p.normal_impulse, pn);
+      store(p.tangent_impulse, pt);
+      largest_change = max(largest_change, abs(dpn) + abs(dpt));
+      largest_impulse = max(largest_impulse, pn + abs(pt));
+      if (change != nullptr) {
+        for (int l = 0; l < kBundleLanes; ++l) {
+          if (b.manifold[l] < 0) continue;
+          double* const c = change + 4 * b.manifold[l] + 2 * k;
+          c[0] = dpn[l];
+          c[1] = dpt[l];
+        }
+        size = size + (dpn * dpn + dpt * dpt);
+      }
+    }
+    scatter(b.body_a, b.ma, a_side, v, w);
+    scatter(b.body_b, b.mb, b_side, v, w);
+  }
+  SweepResult r;
+  for (int l = 0; l < kBundleLanes; ++l) {
+    r.largest_change = std::max(r.largest_change, largest_change[l]);
+    r.largest_impulse = std::max(r.largest_impulse, largest_impulse[l]);
+    r.size += size[l];
+  }
+  return r;
+}
+
+// The sweep built twice: for the x86-64 baseline and for AVX2, picked at run time. The same
+// operations on each lane either way (no fused multiply-add: -ffp-contract=off), so the same
+// impulses to the bit.
+SweepResult sweep_baseline(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
+  return sweep_lanes(bundles, v, w, change);
+}
+#if defined(__x86_64__)
+#define FLOEDEM_HAS_AVX2_SWEEP 1
+[[gnu::target("avx2")]] SweepResult sweep_avx2(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
+  return sweep_lanes(bundles, v, w, change);
+}
+// AVX-512's 32 vector registers (for the same 4-lane vectors) spare the AVX2 build's spills.
+[[gnu::target("avx2,avx512f,avx512vl")]] SweepResult sweep_avx512(std::span<SweepBundle> bundles, Vec2* v, double* w,
+                                                                  double* change) {
+  return sweep_lanes(bundles, v, w, change);
+}
+#endif
+
+// The build in use; set once from the processor, or by use_sweep_isa.
+std::atomic<SweepIsa> sweep_isa{available_sweep_isas().back()};
+
+SweepResult sweep_once(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
+  switch (sweep_isa.load(std::memory_order_relaxed)) {
+#ifdef FLOEDEM_HAS_AVX2_SWEEP
+    case SweepIsa::avx512: return sweep_avx512(bundles, v, w, change);
+    case SweepIsa::avx2: return sweep_avx2(bundles, v, w, change);
+#endif
+    default: return sweep_baseline(bundles, v, w, change);
+  }
+}
+
+// The largest amount by which a point approaches faster than its target (largest_shortfall).
+double largest_shortfall_of(std::span<const SweepBundle> bundles, const BodyArrays& s) {
+  double worst = 0.0;
+  for (const SweepBundle& b : bundles)
+    for (int k = 0; k < b.points; ++k)
+      for (int l = 0; l < kBundleLanes; ++l) {
+        const BundlePoint& p = b.point[k];
+        if (p.target[l] == -std::numeric_limits<double>::infinity()) continue;
+        const Vec2 u = relative_velocity(s, b.body_a[l], b.body_b[l], {p.rax[l], p.ray[l]}, {p.rbx[l], p.rby[l]});
+        worst = std::max(worst, p.target[l] - dot(u, {b.nx[l], b.ny[l]}));
+      }
+  return worst;
+}
+
+double largest_shortfall_of(std::span<const SweepRow> rows, const BodyArrays& s) {
+  double worst = 0.0;
+  for (const SweepRow& r : rows)
+    worst = std::max(worst, r.target_velocity - dot(relative_velocity(s, r.body_a, r.body_b, r.ra, r.rb), r.normal));
+  return worst;
+}
+
+// An empty bundle: every lane without a manifold (lane 0's bodies are set when it gets one).
+void clear_bundle(SweepBundle& b) {
+  b = SweepBundle{};
+  std::fill(std::begin(b.manifold), std::end(b.manifold), -1);
+  for (BundlePoint& p : b.point)
+    for (int l = 0; l < kBundleLanes; ++l) {
+      p.wnn[l] = p.wtt[l] = p.inv_det[l] = p.inv_wnn[l] = p.inv_wtt[l] = 1.0;
+      p.inv_slide_plus[l] = p.inv_slide_minus[l] = 1.0;
+      p.target[l] = -std::numeric_limits<double>::infinity();  // need <= 0: never an impulse
+    }
+}
+
+// Manifold i of the solve (all of them, or the island's).
+struct Selection {
+  std::span<Manifold> manifolds;
+  std::span<const std::int32_t> island;
+  std::size_t size() const { return island.empty() ? manifolds.size() : island.size(); }
+  Manifold& operator[](std::size_t i) const {
+    return island.empty() ? manifolds[i] : manifolds[static_cast<std::size_t>(island[i])];
+  }
+};
+
+constexpr int kColours = 63;  // colours 0..62 in the masks' bits; a manifold that finds none is swept as a row
+
+// Colours the manifolds, packs them into bundles colour by colour (each colour's manifolds in
+// the given order) and those beyond the colours into rows (space.rows, their manifolds listed
+// in space.overflow), and with the warm start applies each point's accumulated impulse in the
+// given order (gather_rows' arithmetic and order). Returns the bundles and the rows.
+struct Gathered {
+  std::size_t bundles = 0, rows = 0, overflow = 0;
+};
+Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, const SweepSpace& space) {
+  const std::span<std::uint64_t> taken = space.body_colours;
+  auto moving = [&](std::int32_t body) { return s.inv_mass[body] != 0.0; };  // as apply_impulse
+  // First pass: each manifold's colour, for now in overflow[i] (kColours: none).
+  std::array<std::size_t, kColours + 1> count{};
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const Manifold& c = m[i];
+    const bool ma = moving(c.body_a), mb = moving(c.body_b);
+    const std::uint64_t near = (ma ? taken[c.body_a] : 0) | (mb ? taken[c.body_b] : 0);
+    const std::uint64_t free = ~near & ((std::uint64_t{1} << kColours) - 1);
+    const int colour = free == 0 ? kColours : std::countr_zero(free);
+    if (colour < kColours) {
+      const std::uint64_t bit = std::uint64_t{1} << colour;
+      if (ma) taken[c.body_a] |= bit;
+      if (mb) taken[c.body_b] |= bit;
+    }
+    space.overflow[i] = colour;
+    ++count[static_cast<std::size_t>(colour)];
+  }
+  // Each colour's first bundle, and how many of its manifolds are placed.
+  std::array<std::size_t, kColours> first{}, placed{};
+  Gathered g;
+  for (int c = 0; c < kColours; ++c) {
+    first[c] = g.bundles;
+    g.bundles += (count[static_cast<std::size_t>(c)] + kBundleLanes - 1) / kBundleLanes;
+  }
+  if (g.bundles > space.bundles.size()) throw std::logic_error("solve_velocities: no room for the coloured bundles");
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const Manifold& c = m[i];
+    if (moving(c.body_a)) taken[c.body_a] = 0;  // all zero again for the next solve (a fixed
+    if (moving(c.body_b)) taken[c.body_b] = 0;  // body's entry, shared across threads, never written)
+    const Vec2 t = perp(c.normal);
+    auto warm = [&](const ManifoldPoint& q) {
+      if (warm_start && (q.normal_impulse != 0.0 || q.tangent_impulse != 0.0))
+        apply_impulse(s, c, q, 1.0 * (q.normal_impulse * c.normal + q.tangent_impulse * t));
+    };
+    const auto colour = static_cast<std::size_t>(space.overflow[i]);
+    if (colour == kColours) {  // no colour left: rows, swept after the bundles
+      space.overflow[g.overflow++] = static_cast<std::int32_t>(i);  // i >= g.overflow: read already
+      for (int k = 0; k < c.point_count; ++k) {
+        const ManifoldPoint& q = c.points[k];
+        space.rows[g.rows++] = {c.body_a, c.body_b, c.normal, q.ra,  q.rb, q.wnn, q.wnt, q.wtt, q.target_velocity,
+                                c.friction, q.normal_impulse, q.tangent_impulse};
+        warm(q);
+      }
+      continue;
+    }
+    const std::size_t n = placed[colour]++;
+    SweepBundle& b = space.bundles[first[colour] + n / kBundleLanes];
+    const auto lane = static_cast<int>(n % kBundleLanes);
+    if (lane == 0) {
+      clear_bundle(b);
+      for (int l = 0; l < kBundleLanes; ++l) {
+        b.body_a[l] = c.body_a;
+        b.body_b[l] = c.body_b;
+      }
+    }
+    b.manifold[lane] = static_cast<std::int32_t>(i);
+    b.body_a[lane] = c.body_a;
+    b.body_b[lane] = c.body_b;
+    b.points = std::max(b.points, static_cast<std::int32_t>(c.point_count));
+    b.nx[lane] = c.normal.x;
+    b.ny[lane] = c.normal.y;
+    b.friction[lane] = c.friction;
+    b.ma[lane] = s.inv_mass[c.body_a];
+    b.ia[lane] = s.inv_inertia[c.body_a];
+    b.mb[lane] = s.inv_mass[c.body_b];
+    b.ib[lane] = s.inv_inertia[c.body_b];
+    for (int k = 0; k < c.point_count; ++k) {
+      const ManifoldPoint& q = c.points[k];
+      BundlePoint& p = b.point[k];
+      p.rax[lane] = q.ra.x;
+      p.ray[lane] = q.ra.y;
+      p.rbx[lane] = q.rb.x;
+      p.rby[lane] = q.rb.y;
+      p.wnn[lane] = q.wnn;
+      p.wnt[lane] = q.wnt;
+      p.wtt[lane] = q.wtt;
+      p.inv_det[lane] = 1.0 / (q.wnn * q.wtt - q.wnt * q.wnt);
+      p.inv_wnn[lane] = 1.0 / q.wnn;
+      p.inv_wtt[lane] = 1.0 / q.wtt;
+      const double plus = q.wnn - c.friction * q.wnt, minus = q.wnn + c.friction * q.wnt;
+      p.inv_slide_plus[lane] = plus > 0.0 ? 1.0 / plus : std::numeric_limits<double>::quiet_NaN();
+      p.inv_slide_minus[lane] = minus > 0.0 ? 1.0 / minus : std::numeric_limits<double>::quiet_NaN();
+      p.target[lane] = q.target_velocity;
+      p.normal_impulse[lane] = q.normal_impulse;
+      p.tangent_impulse[lane] = q.tangent_impulse;
+      warm(q);
+    }
+  }
+  return g;
+}
+
+// The impulses back into their manifolds' points.
+void scatter_bundles(const Selection& m, std::span<const SweepBundle> bundles, std::span<const SweepRow> rows,
+                     std::span<const std::int32_t> overflow) {
+  for (const SweepBundle& b : bundles)
+    for (int l = 0; l < kBundleLanes; ++l) {
+      if (b.manifold[l] < 0) continue;
+      Manifold& c = m[static_cast<std::size_t>(b.manifold[l])];
+      for (int k = 0; k < c.point_count; ++k) {
+        c.points[k].normal_impulse = b.point[k].normal_impulse[l];
+        c.points[k].tangent_impulse = b.point[k].tangent_impulse[l];
+      }
+    }
+  std::size_t x = 0;
+  for (const std::int32_t i : overflow) {
+    Manifold& c = m[static_cast<std::size_t>(i)];
+    for (int k = 0; k < c.point_count; ++k, ++x) {
+      c.points[k].normal_impulse = rows[x].normal_impulse;
+      c.points[k].tangent_impulse = rows[x].tangent_impulse;
+    }
+  }
+}
+
+// The NNCG step beta p added to the impulses (contact_solver.cpp, run_sweeps): over the dense
+// arrays (per manifold), then applied bundle by bundle where any lane's step is not zero. The
+// rows beyond the colours take no step: their changes are not recorded, so their direction
+// stays zero (they are swept plainly; only a body with more than 63 contacts has them).
+void conjugate_step(std::span<SweepBundle> bundles, BodyArrays& s, double beta, std::span<double> direction,
+                    std::span<const double> change, std::span<double> step) {
+  for (std::size_t i = 0; i < direction.size(); ++i) {
+    step[i] = beta * direction[i];
+    direction[i] = step[i] + change[i];
+  }
+  Vec2* const v = s.velocity.data();
+  double* const w = s.angular_velocity.data();
+  for (SweepBundle& b : bundles) {
+    // The lanes' steps, per point: normal and tangent.
+    double sn[2][kBundleLanes] = {}, st[2][kBundleLanes] = {};
+    bool any = false;
+    for (int l = 0; l < kBundleLanes; ++l) {
+      if (b.manifold[l] < 0) continue;
+      const double* const x = step.data() + 4 * b.manifold[l];
+      for (int k = 0; k < b.points; ++k) {
+        sn[k][l] = x[2 * k];
+        st[k][l] = x[2 * k + 1];
+        any = any || sn[k][l] != 0.0 || st[k][l] != 0.0;
+      }
+    }
+    if (!any) continue;
+    Side a_side = gather(b.body_a, v, w), b_side = gather(b.body_b, v, w);
+    const v4d nx = load(b.nx), ny = load(b.ny);
+    for (int k = 0; k < b.points; ++k) {
+      BundlePoint& p = b.point[k];
+      const v4d n_step = load(sn[k]), t_step = load(st[k]);
+      apply(b, p, n_step * nx + t_step * -ny, n_step * ny + t_step * nx, a_side, b_side);
+      store(p.normal_impulse, load(p.normal_impulse) + n_step);
+      store(p.tangent_impulse, load(p.tangent_impulse) + t_step);
+    }
+    scatter(b.body_a, b.ma, a_side, v, w);
+    scatter(b.body_b, b.mb, b_side, v, w);
+  }
+}
+
+}  // namespace
+
+std::vector<SweepIsa> available_sweep_isas() {
+  std::vector<SweepIsa> isas{SweepIsa::baseline};
+#ifdef FLOEDEM_HAS_AVX2_SWEEP
+  __builtin_cpu_init();  // called from a static initialiser too
+  if (__builtin_cpu_supports("avx2")) isas.push_back(SweepIsa::avx2);
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl"))
+    isas.push_back(SweepIsa::avx512);
+#endif
+  return isas;
+}
+
+void use_sweep_isa(SweepIsa isa) {
+  const std::vector<SweepIsa> isas = available_sweep_isas();
+  if (std::find(isas.begin(), isas.end(), isa) == isas.end())
+    throw std::invalid_argument("use_sweep_isa: this processor does not run that build of the sweep");
+  sweep_isa.store(isa);
+}
+
+void use_fastest_sweep_isa() { sweep_isa.store(available_sweep_isas().back()); }
+
+int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& s,
+                   const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate) {
+  const Selection m{manifolds, island};
+  if (space.rows.size() < 2 * m.size() || space.overflow.size() < m.size() ||
+      space.body_colours.size() < s.inv_mass.size() || (accelerate && space.change.size() < 4 * m.size()))
+    throw std::logic_error("solve_velocities: the sweep space has no room for the coloured sweeps");
+  const Gathered g = gather_bundles(m, s, warm_start, space);
+  const std::span<SweepBundle> bundles = space.bundles.first(g.bundles);
+  const std::span<SweepRow> rows = space.rows.first(g.rows);
+  std::span<double> change, direction, step;
+  if (accelerate) {
+    change = space.change.first(4 * m.size());
+    direction = space.direction.first(4 * m.size());
+    step = space.step.first(4 * m.size());
+    std::fill(change.begin(), change.end(), 0.0);
+    std::fill(direction.begin(), direction.end(), 0.0);
+  }
+  // run_sweeps' loop (contact_solver.cpp), over the bundles and then the rows beyond the colours.
+  double previous_size = 0.0;
+  int max_iterations = limits.iterations;
+  int sweep = 0;
+  while (sweep < max_iterations) {
+    ++sweep;
+    SweepResult r =
+        sweep_once(bundles, s.velocity.data(), s.angular_velocity.data(), accelerate ? change.data() : nullptr);
+    for (SweepRow& row : rows) {
+      const RowChange d = sweep_row(row, s);
+      r.largest_change = std::max(r.largest_change, std::abs(d.normal) + std::abs(d.tangent));
+      r.largest_impulse = std::max(r.largest_impulse, row.normal_impulse + std::abs(row.tangent_impulse));
+    }
+    if (r.largest_change <= limits.tolerance * r.largest_impulse) break;
+    if (sweep >= limits.iterations && (sweep - limits.iterations) % SweepLimits::check_every == 0 &&
+        limits.extra_iterations > 0) {
+      if (std::max(largest_shortfall_of(bundles, s), largest_shortfall_of(rows, s)) <= limits.closing_speed) break;
+      max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + SweepLimits::check_every);
+    }
+    if (!accelerate || sweep == max_iterations) continue;
+    if (previous_size > 0.0 && r.size > previous_size)
+      std::fill(direction.begin(), direction.end(), 0.0);  // the merit rose: restart
+    else
+      conjugate_step(bundles, s, previous_size > 0.0 ? r.size / previous_size : 0.0, direction, change, step);
+    previous_size = r.size;
+  }
+  scatter_bundles(m, bundles, rows, space.overflow.first(g.overflow));
+  return sweep;
+}
+
+}  // namespace floedem

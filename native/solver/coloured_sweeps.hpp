@@ -1,0 +1,51 @@
+#pragma once
+// Gauss-Seidel sweeps in colour order, four manifolds side by side (the native engine's
+// `coloured_sweeps`; contact_solver.cpp keeps the sweeps in pair order, the default).
+//
+// The sweeps in pair order update point after point, each reading the velocities the one before
+// it wrote. A pair list sorted by part puts a floe's contacts one after another, so each update
+// waits for the last one's stores, and the local solve's branches (separating, stick, slide
+// either way) are taken at random: about 14 ns a point on the packed 16k field, most of it
+// waiting. Greedy graph colouring of the manifolds (Box2D v3's constraint graph colouring;
+// greedy colouring: Welsh and Powell 1967) gives each manifold the lowest colour that no other
+// manifold of either of its moving bodies took. Within a colour no two manifolds share a moving
+// body, so their updates commute: four of them (a bundle) are solved at once, lane by lane in
+// SIMD vectors, the local solve's cases all computed and the right one selected (no branch).
+// A manifold's two points are solved one after the other (a near block solve; solving every
+// first point before every second point cost convergence, issue 8). Fixed and towed bodies are
+// only read (as apply_impulse) and take no colour. A body with more than 63 manifolds sends the
+// rest to a last group, one manifold a bundle, swept in order.
+//
+// It is another Gauss-Seidel order of the same points with the same local solve (the same
+// arithmetic per point as local_impulse, sweep_row.hpp), so it converges to the same solution;
+// after a given number of sweeps its impulses differ from the pair order's (a setting, not an
+// optimisation of the default: results are not the pair order's to the bit). Each lane's
+// arithmetic is IEEE double, no fused multiply-add (CMakeLists), so the result is the same on
+// any x86-64, with or without AVX2, and on any number of threads (an island is one task).
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "solver/contact_solver.hpp"
+
+namespace floedem {
+
+/// The coloured solve of the manifolds `island` (indices into `manifolds`, in order; empty: all
+/// of them): solve_velocities with SweepOptions::colour. `space` needs bundles and slots for
+/// the manifolds, the scene's body_colours (all zero, and left so) and, with `accelerate`,
+/// bundle_change/direction/step (SweepWork::reserve with colour_bodies).
+int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& bodies,
+                   const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate);
+
+/// The builds of the sweep (the same impulses to the bit): the x86-64 baseline (SSE2), AVX2,
+/// and AVX2 with AVX-512's 32 registers. The fastest the processor has runs unless a test or a
+/// benchmark asks for another.
+enum class SweepIsa { baseline, avx2, avx512 };
+/// Those this processor runs, slowest first.
+std::vector<SweepIsa> available_sweep_isas();
+/// The build every coloured sweep uses from now on (one this processor runs).
+void use_sweep_isa(SweepIsa isa);
+/// Back to the fastest.
+void use_fastest_sweep_isa();
+
+}  // namespace floedem

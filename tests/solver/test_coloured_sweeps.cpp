@@ -1,0 +1,212 @@
+// The coloured sweeps (native/solver/coloured_sweeps.cpp): another Gauss-Seidel order of the
+// same points, four manifolds at a time. Held to: the same converged velocities as the sweeps
+// in pair order (frictionless: the velocities after a converged solve are unique, the impulses
+// of a redundant pack are not); Signorini and Coulomb at every point of a frictional pack; no
+// kinetic energy made; a body with more contacts than there are colours; the same bits from
+// every build of the sweep (baseline, AVX2, AVX-512) and on any number of threads.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "parallel/thread_pool.hpp"
+#include "parallel/threads.hpp"
+#include "run/stepper.hpp"
+#include "scenario/scenario.hpp"
+#include "solver/coloured_sweeps.hpp"
+#include "solver/contact_solver.hpp"
+#include "solver/pressed_pack.hpp"
+
+using namespace floedem;
+using namespace floedem::test;
+
+namespace {
+
+struct Solved {
+  Pack state;
+  int sweeps = 0;
+};
+
+Solved solve(const Pack& start, const SweepLimits& limits, bool colour, bool accelerate = false,
+             bool warm_start = true) {
+  Solved s{start, 0};
+  SweepWork work;
+  s.sweeps = solve_velocities(
+      s.state.manifolds, s.state.bodies, limits,
+      work.space(s.state.manifolds.size(), accelerate, colour ? s.state.bodies.inv_mass.size() : 0),
+      {.warm_start = warm_start, .accelerate = accelerate, .colour = colour});
+  return s;
+}
+
+double twice_kinetic_energy(const BodyArrays& b) {
+  double e = 0.0;
+  for (std::size_t i = 0; i < b.position.size(); ++i)
+    if (b.inv_mass[i] != 0.0)
+      e += length_squared(b.velocity[i]) / b.inv_mass[i] + b.angular_velocity[i] * b.angular_velocity[i] / b.inv_inertia[i];
+  return e;
+}
+
+// A star: a heavy floe (body 1) with `spokes` small floes touching it all round (bodies 2...),
+// each at two points, the heavy one drifting into them: more manifolds on one moving body than
+// there are colours (63), so the rest are swept as rows.
+Pack star(int spokes) {
+  Pack p;
+  const auto n = static_cast<std::size_t>(spokes) + 2;
+  p.bodies.resize(n);
+  p.bodies.rotation.assign(n, Rot::from_angle(0.0));
+  p.bodies.inv_mass.assign(n, 0.0);
+  p.bodies.inv_inertia.assign(n, 0.0);
+  p.bodies.inv_mass[1] = 1.0 / 1e8;
+  p.bodies.inv_inertia[1] = 1.0 / 1e12;
+  p.bodies.velocity[1] = {0.3, 0.1};
+  const double radius = 200.0;
+  for (int k = 0; k < spokes; ++k) {
+    const double angle = 2.0 * M_PI * k / spokes;
+    const Vec2 out{std::cos(angle), std::sin(angle)};
+    const auto b = static_cast<std::size_t>(k) + 2;
+    p.bodies.position[b] = (radius + 2.0) * out;
+    p.bodies.velocity[b] = {0.0, 0.0};
+    p.bodies.inv_mass[b] = 1.0 / 9e4;
+    p.bodies.inv_inertia[b] = 1.0 / 1.5e6;
+    Manifold m;
+    m.body_a = m.part_a = 1;
+    m.body_b = m.part_b = static_cast<std::int32_t>(b);
+    m.normal = out;
+    m.friction = 0.3;
+    m.restitution = 0.2;
+    m.point_count = 2;
+    for (int q = 0; q < 2; ++q) {
+      m.points[q].point = radius * out + (q == 0 ? 1.0 : -1.0) * perp(out);
+      m.points[q].separation = -0.001;
+      m.points[q].id = static_cast<std::uint32_t>(q);
+    }
+    prepare_contact(m, p.bodies, 0.05, 0.01);
+    p.manifolds.push_back(m);
+  }
+  return p;
+}
+
+// Signorini and Coulomb at every point: P_n >= 0 and |P_t| <= mu P_n exactly (each local solve
+// ends inside the cone); returns the largest Signorini residual, max(u* - u_n, 0) or, where the
+// point carries an impulse, |u_n - u*| (m/s).
+double check_laws(const Pack& p) {
+  double worst = 0.0;
+  for (const Manifold& m : p.manifolds)
+    for (int k = 0; k < m.point_count; ++k) {
+      const ManifoldPoint& q = m.points[k];
+      const double gap = dot(relative_velocity(p.bodies, m.body_a, m.body_b, q.ra, q.rb), m.normal) - q.target_velocity;
+      CHECK(q.normal_impulse >= 0.0);
+      CHECK(std::abs(q.tangent_impulse) <= m.friction * q.normal_impulse * (1.0 + 1e-12));
+      worst = std::max(worst, q.normal_impulse > 0.0 ? std::abs(gap) : std::max(-gap, 0.0));
+    }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("coloured sweeps: the same converged velocities as the sweeps in pair order", "[solver][coloured]") {
+  // Frictionless: the converged velocities are the projection of the free ones onto the
+  // admissible set in the mass metric, unique however the impulses of a redundant pack (two
+  // points a face) share the load. 20 000 sweeps with NNCG converge both orders to round-off.
+  Pack start = pack(12, 8, 5, false);
+  for (Manifold& m : start.manifolds) {
+    m.friction = 0.0;
+    for (ManifoldPoint& q : m.points) q.tangent_impulse = 0.0;
+  }
+  const SweepLimits limits{20000, 1e-14};
+  const Solved pairs = solve(start, limits, false, true);
+  const Solved colours = solve(start, limits, true, true);
+  double largest = 0.0;
+  for (const Vec2 v : pairs.state.bodies.velocity) largest = std::max(largest, length(v));
+  REQUIRE(largest > 0.1);
+  for (std::size_t b = 0; b < start.bodies.position.size(); ++b) {
+    INFO("body " << b);
+    // 1e-9 of the largest speed: round-off of the two orders' sums, far below any physical speed.
+    CHECK(length(colours.state.bodies.velocity[b] - pairs.state.bodies.velocity[b]) <= 1e-9 * largest);
+    CHECK(std::abs(colours.state.bodies.angular_velocity[b] - pairs.state.bodies.angular_velocity[b]) * 10.0 <=
+          1e-9 * largest);
+  }
+}
+
+TEST_CASE("coloured sweeps: a frictional pack meets Signorini and Coulomb as well as the pair order", "[solver][coloured]") {
+  // With friction, Gauss-Seidel need not converge to round-off (a point that slides one sweep
+  // and sticks the next), in either order: after 200 sweeps the coloured solve is held to the
+  // cone exactly and to the pair order's Signorini residual, within a factor 2.
+  const bool accelerate = GENERATE(false, true);
+  const Pack start = pack(20, 12, 9, true);
+  const double pairs = check_laws(solve(start, {200, 0.0}, false, accelerate).state);
+  const double colours = check_laws(solve(start, {200, 0.0}, true, accelerate).state);
+  INFO((accelerate ? "NNCG" : "plain sweeps") << ": residual " << colours << " m/s, pair order " << pairs);
+  CHECK(colours <= 2.0 * pairs + 1e-12);
+}
+
+TEST_CASE("coloured sweeps: plain sweeps from zero make no kinetic energy", "[solver][coloured]") {
+  // Each local update projects the velocities onto its constraint in the mass metric, in any
+  // order (contact_solver.cpp): from zero impulses and without the warm start, 10 sweeps of a
+  // pack with collisions and friction leave no more kinetic energy than they found.
+  Pack start = pack(20, 12, 3, true);
+  for (Manifold& m : start.manifolds)
+    for (ManifoldPoint& q : m.points) q.normal_impulse = q.tangent_impulse = 0.0;
+  const double before = twice_kinetic_energy(start.bodies);
+  const Solved colours = solve(start, {10, 0.0}, true, false, /*warm_start=*/false);
+  CHECK(twice_kinetic_energy(colours.state.bodies) <= before * (1.0 + 1e-14));
+}
+
+TEST_CASE("coloured sweeps: a floe with more contacts than colours", "[solver][coloured]") {
+  // 100 floes round a heavy one: 63 of its manifolds get colours, 37 are swept as rows. The
+  // converged solve meets the laws, and the heavy floe's velocity is the pair order's.
+  const Pack start = star(100);
+  const bool accelerate = GENERATE(false, true);
+  INFO((accelerate ? "NNCG" : "plain sweeps"));
+  const SweepLimits limits{20000, 1e-14};
+  const Solved colours = solve(start, limits, true, accelerate);
+  CHECK(check_laws(colours.state) <= 1e-9);  // m/s: converged to round-off
+  const Solved pairs = solve(start, limits, false, accelerate);
+  CHECK(length(colours.state.bodies.velocity[1] - pairs.state.bodies.velocity[1]) <= 1e-9);
+  // Momentum: every impulse acts on two moving bodies, so the total is conserved to round-off.
+  Vec2 before, after;
+  for (std::size_t b = 1; b < start.bodies.position.size(); ++b) {
+    before += (1.0 / start.bodies.inv_mass[b]) * start.bodies.velocity[b];
+    after += (1.0 / start.bodies.inv_mass[b]) * colours.state.bodies.velocity[b];
+  }
+  CHECK(length(after - before) <= 1e-9 * length(before));
+}
+
+TEST_CASE("coloured sweeps: every build of the sweep gives the same impulses to the bit", "[solver][coloured]") {
+  const std::vector<SweepIsa> isas = available_sweep_isas();
+  REQUIRE(isas.front() == SweepIsa::baseline);
+  const bool accelerate = GENERATE(false, true);
+  for (const Pack& start : {pack(30, 20, 17, true), star(80)}) {
+    use_sweep_isa(SweepIsa::baseline);
+    const Solved reference = solve(start, {40, 0.0, 20, 1e-6}, true, accelerate);
+    for (const SweepIsa isa : isas) {
+      INFO("build " << static_cast<int>(isa) << (accelerate ? ", NNCG" : ""));
+      use_sweep_isa(isa);
+      const Solved other = solve(start, {40, 0.0, 20, 1e-6}, true, accelerate);
+      CHECK(other.sweeps == reference.sweeps);
+      CHECK(same_bits(other.state.bodies.velocity, reference.state.bodies.velocity));
+      CHECK(same_bits(other.state.bodies.angular_velocity, reference.state.bodies.angular_velocity));
+      CHECK(same_impulses(other.state.manifolds, reference.state.manifolds));
+    }
+  }
+  use_fastest_sweep_isa();
+  CHECK_THROWS(use_sweep_isa(static_cast<SweepIsa>(7)));
+}
+
+TEST_CASE("coloured sweeps: the native engine gives the same state on 1 and 2 threads", "[solver][coloured][threads]") {
+  // The 1k field benchmark driven onto its wall at twice its current, with coloured sweeps and
+  // the default NNCG: each island is one task on any thread, so the state is the same to the bit.
+  const Scene scene = load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml",
+                                    {"environment.current=[1.0, 0.0]", "engine.native.coloured_sweeps=true",
+                                     "engine.native.accelerate=true", "engine.native.extra_iterations=100"});
+  constexpr int kSteps = 600;  // 30 s at dt 0.05 s
+  BodyStates states[2];
+  for (const unsigned threads : {1u, 2u}) {
+    set_thread_pool_size(threads);
+    Stepper stepper(scene, "native");
+    for (int k = 0; k < kSteps; ++k) stepper.step();
+    states[threads - 1] = stepper.state();
+  }
+  set_thread_pool_size(worker_threads());
+  check_same_state(states[0], states[1]);
+}
