@@ -34,8 +34,11 @@ namespace floedem {
 /// of them): solve_velocities with SweepOptions::colour. `space` needs bundles and slots for
 /// the manifolds, the scene's body_colours (all zero, and left so) and, with `accelerate`,
 /// bundle_change/direction/step (SweepWork::reserve with colour_bodies).
+/// With `threads`, each colour's bundles are swept on the pool's threads (not from inside a
+/// loop of the pool): the same impulses to the bit as without.
 int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& bodies,
-                   const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate);
+                   const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate,
+                   bool threads = false);
 
 /// The builds of the sweep (the same impulses to the bit): the x86-64 baseline (SSE2), AVX2,
 /// and AVX2 with AVX-512's 32 registers. The fastest the processor has runs unless a test or a

@@ -137,7 +137,8 @@ struct SweepOptions {
   SweepPipeline* pipeline = nullptr;
   /// Sweep the manifolds colour by colour, four at a time (coloured_sweeps.hpp), instead of in
   /// the order given: another Gauss-Seidel order, so other impulses after a given number of
-  /// sweeps. Needs the space's coloured arrays; `pipeline` is not used.
+  /// sweeps. Needs the space's coloured arrays. With `pipeline` (which it does not use), each
+  /// colour is swept on the pool's threads, with `accelerate` too: the same to the bit.
   bool colour = false;
 };
 /// `space` must hold manifolds.size() manifolds (and their accelerated arrays with `accelerate`).

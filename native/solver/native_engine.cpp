@@ -640,9 +640,10 @@ void NativeEngine::solve_contacts() {
   for (IslandWork& w : island_work_) w.longest = w.cold_restarts = 0;
   // An island with rows enough for several threads' worth (the packed field's one large island)
   // is left out of the blocks and solved after them on every thread at once, its plain sweeps
-  // pipelined (sweep_pipeline.hpp): on two threads, the rest of the islands and it would
-  // otherwise wait for the one thread that has it.
-  const bool pipelined = !settings_.accelerate && !settings_.coloured_sweeps && thread_pool().size() > 1;
+  // pipelined (sweep_pipeline.hpp), or its colours swept on every thread (coloured sweeps, NNCG
+  // or not): on two threads, the rest of the islands and it would otherwise wait for the one
+  // thread that has it.
+  const bool pipelined = (!settings_.accelerate || settings_.coloured_sweeps) && thread_pool().size() > 1;
   auto large = [&](std::size_t i) {
     return pipelined && SweepPipeline::parts_for(2 * islands_.manifolds(i).size()) > 1;
   };
