@@ -276,24 +276,47 @@ struct Gathered {
   std::size_t bundles = 0, rows = 0, overflow = 0;
   std::array<std::size_t, kColours + 1> colour_start{};  // each colour's first bundle
 };
-Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, const SweepSpace& space) {
-  const std::span<std::uint64_t> taken = space.body_colours;
+// Each manifold's colour into colours[i] (kColours: none left); the counts per colour.
+// body_colours is all zero again on return (a fixed body's entry, shared across threads, is
+// never written).
+std::array<std::size_t, kColours + 1> colour(const Selection& m, const BodyArrays& s, std::span<std::int32_t> colours,
+                                             std::span<std::uint64_t> taken) {
   auto moving = [&](std::int32_t body) { return s.inv_mass[body] != 0.0; };  // as apply_impulse
-  // First pass: each manifold's colour, for now in overflow[i] (kColours: none).
   std::array<std::size_t, kColours + 1> count{};
   for (std::size_t i = 0; i < m.size(); ++i) {
     const Manifold& c = m[i];
     const bool ma = moving(c.body_a), mb = moving(c.body_b);
     const std::uint64_t near = (ma ? taken[c.body_a] : 0) | (mb ? taken[c.body_b] : 0);
     const std::uint64_t free = ~near & ((std::uint64_t{1} << kColours) - 1);
-    const int colour = free == 0 ? kColours : std::countr_zero(free);
-    if (colour < kColours) {
-      const std::uint64_t bit = std::uint64_t{1} << colour;
+    const int k = free == 0 ? kColours : std::countr_zero(free);
+    if (k < kColours) {
+      const std::uint64_t bit = std::uint64_t{1} << k;
       if (ma) taken[c.body_a] |= bit;
       if (mb) taken[c.body_b] |= bit;
     }
-    space.overflow[i] = colour;
-    ++count[static_cast<std::size_t>(colour)];
+    colours[i] = k;
+    ++count[static_cast<std::size_t>(k)];
+  }
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    if (moving(m[i].body_a)) taken[m[i].body_a] = 0;
+    if (moving(m[i].body_b)) taken[m[i].body_b] = 0;
+  }
+  return count;
+}
+
+std::size_t bundles_of(const std::array<std::size_t, kColours + 1>& count) {
+  std::size_t bundles = 0;
+  for (int c = 0; c < kColours; ++c) bundles += (count[static_cast<std::size_t>(c)] + kBundleLanes - 1) / kBundleLanes;
+  return bundles;
+}
+
+Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, const SweepSpace& space) {
+  // Each manifold's colour in overflow[i], made here unless colour_manifolds made it.
+  std::array<std::size_t, kColours + 1> count{};
+  if (space.colours_given) {
+    for (std::size_t i = 0; i < m.size(); ++i) ++count[static_cast<std::size_t>(space.overflow[i])];
+  } else {
+    count = colour(m, s, space.overflow, space.body_colours);
   }
   // Each colour's first bundle, and how many of its manifolds are placed.
   std::array<std::size_t, kColours> first{}, placed{};
@@ -306,8 +329,6 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, cons
   if (g.bundles > space.bundles.size()) throw std::logic_error("solve_velocities: no room for the coloured bundles");
   for (std::size_t i = 0; i < m.size(); ++i) {
     const Manifold& c = m[i];
-    if (moving(c.body_a)) taken[c.body_a] = 0;  // all zero again for the next solve (a fixed
-    if (moving(c.body_b)) taken[c.body_b] = 0;  // body's entry, shared across threads, never written)
     const Vec2 t = perp(c.normal);
     auto warm = [&](const ManifoldPoint& q) {
       if (warm_start && (q.normal_impulse != 0.0 || q.tangent_impulse != 0.0))
@@ -472,6 +493,12 @@ void conjugate_step(std::span<SweepBundle> bundles, BodyArrays& s, double beta, 
 }
 
 }  // namespace
+
+std::size_t colour_manifolds(std::span<Manifold> manifolds, std::span<const std::int32_t> island,
+                             const BodyArrays& bodies, std::span<std::int32_t> colours,
+                             std::span<std::uint64_t> body_colours) {
+  return bundles_of(colour(Selection{manifolds, island}, bodies, colours, body_colours));
+}
 
 std::vector<SweepIsa> available_sweep_isas() {
   std::vector<SweepIsa> isas{SweepIsa::baseline};

@@ -40,6 +40,14 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
                    const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate,
                    bool threads = false);
 
+/// The colours solve_coloured gives the manifolds `island` (its first pass, made apart): each
+/// manifold's colour into colours[i], body_colours all zero again on return. Returns the
+/// bundles they take, so that a caller can give each island's solve the room it needs, and the
+/// solve the colours (SweepSpace::colours_given).
+std::size_t colour_manifolds(std::span<Manifold> manifolds, std::span<const std::int32_t> island,
+                             const BodyArrays& bodies, std::span<std::int32_t> colours,
+                             std::span<std::uint64_t> body_colours);
+
 /// The builds of the sweep (the same impulses to the bit): the x86-64 baseline (SSE2), AVX2,
 /// and AVX2 with AVX-512's 32 registers. The fastest the processor has runs unless a test or a
 /// benchmark asks for another.

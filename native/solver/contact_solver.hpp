@@ -84,6 +84,7 @@ struct SweepSpace {
   std::span<SweepBundle> bundles;
   std::span<std::int32_t> overflow;
   std::span<std::uint64_t> body_colours;
+  bool colours_given = false;  ///< overflow holds each manifold's colour (colour_manifolds); a solve overwrites them
 };
 
 /// The storage behind SweepSpaces, kept by the caller (no allocation per step once sized).

@@ -19,6 +19,7 @@
 #include "solver/broad_phase.hpp"
 #include "solver/pair_cache.hpp"
 #include "solver/contact_islands.hpp"
+#include "solver/coloured_sweeps.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/headroom.hpp"
 #include "solver/island_solve.hpp"
@@ -489,7 +490,7 @@ PartGeometry NativeEngine::part_geometry(std::int32_t k) const {
 void NativeEngine::collide_pairs(bool redetection) {
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
-  narrow_.resize(pairs_.size());
+  resize_with_headroom(narrow_, pairs_.size());  // with room: the pairs set new highs as a pack breathes
   // Per pair, its slot at the last narrow phase (both lists sorted): its separation hint
   // carries over, and where both parts were kept in place with the same reaches, its manifold.
   // A redetection's narrow phase follows the step's first one with every part where it was
@@ -625,14 +626,21 @@ void NativeEngine::solve_contacts() {
   const std::size_t n = islands_.size();
   const std::size_t blocks = std::max<std::size_t>(1, (n + kIslandGrain - 1) / kIslandGrain);
   if (island_work_.size() < blocks) island_work_.resize(blocks + blocks / 2);
+  const std::size_t colour_bodies = settings_.coloured_sweeps ? bodies_.inv_mass.size() : 0;
+  sweep_work_.reserve(manifolds_.size(), settings_.accelerate, colour_bodies);
   if (settings_.coloured_sweeps) {
-    // Each island's bundles in a slice of their own, sized for its manifolds (bundles_for).
+    // The islands coloured first, so that each island's bundles get a slice of exactly their
+    // number (a bound per island, bundles_for, came to a bundle a manifold for the many small
+    // islands: 1 280 bytes each, and a total that grew as the pack broke up and closed again).
     resize_with_headroom(island_bundles_, n + 1);
     island_bundles_[0] = 0;
-    for (std::size_t i = 0; i < n; ++i) island_bundles_[i + 1] = island_bundles_[i] + bundles_for(islands_.manifolds(i).size());
+    for (std::size_t i = 0; i < n; ++i) {
+      const SweepSpace space = sweep_work_.slice(islands_.manifold_offset(i), islands_.manifolds(i).size());
+      island_bundles_[i + 1] = island_bundles_[i] + colour_manifolds(manifolds_, islands_.manifolds(i), bodies_,
+                                                                     space.overflow, space.body_colours);
+    }
+    sweep_work_.reserve(manifolds_.size(), settings_.accelerate, colour_bodies, island_bundles_[n]);
   }
-  sweep_work_.reserve(manifolds_.size(), settings_.accelerate, settings_.coloured_sweeps ? bodies_.inv_mass.size() : 0,
-                      settings_.coloured_sweeps ? island_bundles_[n] : 0);
   if (checked) {
     resize_with_headroom(island_velocity_, islands_.body_count());
     resize_with_headroom(island_angular_velocity_, islands_.body_count());
@@ -691,11 +699,12 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
       island_angular_velocity_[at + x] = bodies_.angular_velocity[bodies[x]];
     }
   }
-  const SweepSpace space =
-      settings_.coloured_sweeps
-          ? sweep_work_.slice(islands_.manifold_offset(island), manifolds.size(), island_bundles_[island],
-                              island_bundles_[island + 1] - island_bundles_[island])
-          : sweep_work_.slice(islands_.manifold_offset(island), manifolds.size());
+  SweepSpace space = sweep_work_.slice(islands_.manifold_offset(island), manifolds.size());
+  if (settings_.coloured_sweeps) {
+    space = sweep_work_.slice(islands_.manifold_offset(island), manifolds.size(), island_bundles_[island],
+                              island_bundles_[island + 1] - island_bundles_[island]);
+    space.colours_given = true;  // by solve_contacts
+  }
   int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,
                                 {.warm_start = settings_.warm_start,
                                  .accelerate = settings_.accelerate,
@@ -714,6 +723,7 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
     Manifold& m = manifolds_[k];
     for (int j = 0; j < m.point_count; ++j) m.points[j].normal_impulse = m.points[j].tangent_impulse = 0.0;
   }
+  space.colours_given = false;  // the first solve kept its list of rows beyond the colours there: colour again
   sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,  // plain sweeps: no energy made
                              {.pipeline = pipeline, .colour = settings_.coloured_sweeps});
   ++work.cold_restarts;
