@@ -15,8 +15,8 @@
 
 // The conditions each point's local solve meets, and the Delassus block, are stated in
 // contact_solver.cpp; the case-by-case solve is local_impulse (sweep_row.hpp), of which
-// local_lanes below is the same arithmetic with every case computed and the first that holds
-// selected.
+// local_lanes below is the same law with every case computed and the first that holds
+// selected, its divisions made once a step as reciprocals.
 
 namespace floedem {
 
@@ -51,9 +51,9 @@ struct Side {
   v4d vx, vy, w;
 };
 
-// Four lanes from four places, as two pairs joined: built as v4d{a, b, c, d}, GCC loads each
-// lane into the register that held the previous bundle's vector (vmovlpd merges), which chains
-// every bundle to the one before it and leaves the sweep one bundle at a time.
+// Four lanes from four places, as two pairs joined: built as v4d{a, b, c, d}, GCC 12 loads
+// each lane into the register that held the previous bundle's vector (vmovlpd merges), a
+// false dependence that chains each bundle to the one before it.
 using v2d = double __attribute__((vector_size(16)));
 FLOEDEM_LANES v4d lanes(double a, double b, double c, double d) {
   const v2d low{a, b}, high{c, d};
@@ -89,8 +89,8 @@ FLOEDEM_LANES void apply(const SweepBundle& b, const BundlePoint& p, v4d px, v4d
 
 // local_impulse (sweep_row.hpp) on four lanes: each case's impulse computed, then the first
 // case that holds, in local_impulse's order, selected. Its divisions are multiplications by
-// the point's reciprocals (fixed for the step): a division's latency, three of them on the
-// chain from one point's velocities to the next's, held the sweep more than its arithmetic.
+// the point's reciprocals, made once a step when the bundle is packed instead of every sweep
+// (so the impulses differ from local_impulse's by rounding).
 FLOEDEM_LANES void local_lanes(const BundlePoint& p, v4d ufn, v4d uft, v4d mu, v4d& pn, v4d& pt) {
   // Written so that few values are live at once (the Side velocities, the normal and the sweep's
   // maxima hold most of the sixteen registers of AVX2): each case, from the last to the first,
@@ -186,9 +186,9 @@ FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, d
   return r;
 }
 
-// The sweep built twice: for the x86-64 baseline and for AVX2, picked at run time. The same
-// operations on each lane either way (no fused multiply-add: -ffp-contract=off), so the same
-// impulses to the bit.
+// The sweep built three times: for the x86-64 baseline, for AVX2 and for AVX-512, the fastest
+// the processor runs picked at run time. The same operations on each lane in each (no fused
+// multiply-add: -ffp-contract=off), so the same impulses to the bit (tested).
 SweepResult sweep_baseline(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
   return sweep_lanes(bundles, v, w, change);
 }
@@ -254,6 +254,23 @@ void empty_lane(SweepBundle& b, int l) {
   b.nx[l] = b.ny[l] = b.friction[l] = 0.0;
   b.ma[l] = b.ia[l] = b.mb[l] = b.ib[l] = 0.0;
   for (BundlePoint& p : b.point) empty_point(p, l);
+}
+
+// The local solve's divisors of a full bundle's points as reciprocals, four lanes at a time
+// (an empty lane's are 1; a slide's divisor that is not positive gives NaN: never holds).
+void reciprocals(SweepBundle& b) {
+  const v4d mu = load(b.friction), zero = splat(0.0), one = splat(1.0);
+  const v4d nan = splat(std::numeric_limits<double>::quiet_NaN());
+  for (int k = 0; k < b.points; ++k) {
+    BundlePoint& p = b.point[k];
+    const v4d wnn = load(p.wnn), wnt = load(p.wnt), wtt = load(p.wtt);
+    store(p.inv_det, one / (wnn * wtt - wnt * wnt));
+    store(p.inv_wnn, one / wnn);
+    store(p.inv_wtt, one / wtt);
+    const v4d plus = wnn - mu * wnt, minus = wnn + mu * wnt;
+    store(p.inv_slide_plus, select((v4m)(plus > zero), one / plus, nan));
+    store(p.inv_slide_minus, select((v4m)(minus > zero), one / minus, nan));
+  }
 }
 
 // Manifold i of the solve (all of them, or the island's).
@@ -370,23 +387,20 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, cons
       p.wnn[lane] = q.wnn;
       p.wnt[lane] = q.wnt;
       p.wtt[lane] = q.wtt;
-      p.inv_det[lane] = 1.0 / (q.wnn * q.wtt - q.wnt * q.wnt);
-      p.inv_wnn[lane] = 1.0 / q.wnn;
-      p.inv_wtt[lane] = 1.0 / q.wtt;
-      const double plus = q.wnn - c.friction * q.wnt, minus = q.wnn + c.friction * q.wnt;
-      p.inv_slide_plus[lane] = plus > 0.0 ? 1.0 / plus : std::numeric_limits<double>::quiet_NaN();
-      p.inv_slide_minus[lane] = minus > 0.0 ? 1.0 / minus : std::numeric_limits<double>::quiet_NaN();
       p.target[lane] = q.target_velocity;
       p.normal_impulse[lane] = q.normal_impulse;
       p.tangent_impulse[lane] = q.tangent_impulse;
       warm(q);
     }
     if (c.point_count == 1) empty_point(b.point[1], lane);
+    if (lane == kBundleLanes - 1) reciprocals(b);  // full
   }
   for (int c = 0; c < kColours; ++c) {  // the lanes left in each colour's last bundle
     const std::size_t n = count[static_cast<std::size_t>(c)];
-    for (auto l = static_cast<int>(n % kBundleLanes); n % kBundleLanes != 0 && l < kBundleLanes; ++l)
-      empty_lane(space.bundles[first[c] + n / kBundleLanes], l);
+    if (n % kBundleLanes == 0) continue;
+    SweepBundle& b = space.bundles[first[c] + n / kBundleLanes];
+    for (auto l = static_cast<int>(n % kBundleLanes); l < kBundleLanes; ++l) empty_lane(b, l);
+    reciprocals(b);
   }
   return g;
 }

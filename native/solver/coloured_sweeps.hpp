@@ -16,12 +16,17 @@
 // only read (as apply_impulse) and take no colour. A body with more than 63 manifolds sends the
 // rest to a last group, one manifold a bundle, swept in order.
 //
-// It is another Gauss-Seidel order of the same points with the same local solve (the same
-// arithmetic per point as local_impulse, sweep_row.hpp), so it converges to the same solution;
-// after a given number of sweeps its impulses differ from the pair order's (a setting, not an
-// optimisation of the default: results are not the pair order's to the bit). Each lane's
-// arithmetic is IEEE double, no fused multiply-add (CMakeLists), so the result is the same on
-// any x86-64, with or without AVX2, and on any number of threads (an island is one task).
+// It is another Gauss-Seidel order of the same points with the same local law (local_impulse,
+// sweep_row.hpp, with its divisions as reciprocals made once a step), so it converges to the
+// same solution; after a given number of sweeps its impulses differ from the pair order's (a
+// setting, not an optimisation of the default: results are not the pair order's to the bit).
+// Each lane's arithmetic is IEEE double, no fused multiply-add (CMakeLists), so the result is
+// the same on any x86-64, with or without AVX2 or AVX-512, and on any number of threads (a
+// large island's colours are swept in fixed blocks on the pool's threads).
+//
+// Measured (2-core AMD EPYC VM, one thread): the 1k field's step of sweeps 273-276 us against
+// 354-360 in pair order (BM_ContactSweeps*); the 16k field's contact solve 0.7 to 0.75 times
+// the pair order's (floedem bench --stages, alternating runs), with less mean penetration.
 #include <cstdint>
 #include <span>
 #include <vector>
