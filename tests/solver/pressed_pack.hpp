@@ -90,6 +90,13 @@ inline bool same_impulses(const std::vector<Manifold>& a, const std::vector<Mani
   return true;
 }
 
+/// The same velocities and impulses to the bit (a pack solved two ways).
+inline void check_same_solve(const Pack& a, const Pack& b) {
+  CHECK(same_bits(a.bodies.velocity, b.bodies.velocity));
+  CHECK(same_bits(a.bodies.angular_velocity, b.bodies.angular_velocity));
+  CHECK(same_impulses(a.manifolds, b.manifolds));
+}
+
 /// Every body's pose and velocity the same to the bit (an engine run two ways).
 inline void check_same_state(const BodyStates& a, const BodyStates& b) {
   CHECK(same_bits(a.velocity, b.velocity));
