@@ -231,13 +231,6 @@ double largest_shortfall_of(std::span<const SweepBundle> bundles, const BodyArra
   return worst;
 }
 
-double largest_shortfall_of(std::span<const SweepRow> rows, const BodyArrays& s) {
-  double worst = 0.0;
-  for (const SweepRow& r : rows)
-    worst = std::max(worst, r.target_velocity - dot(relative_velocity(s, r.body_a, r.body_b, r.ra, r.rb), r.normal));
-  return worst;
-}
-
 // A lane's point that is not there: no impulse ever (need <= 0), finite arithmetic.
 void empty_point(BundlePoint& p, int l) {
   p.rax[l] = p.ray[l] = p.rbx[l] = p.rby[l] = p.wnt[l] = 0.0;

@@ -123,13 +123,6 @@ struct IslandRows {
   Manifold& operator[](std::size_t i) const { return m[static_cast<std::size_t>(index[i])]; }
 };
 
-// largest_shortfall over the rows (the same points in the same order).
-double largest_shortfall_of(std::span<const SweepRow> rows, const BodyArrays& s) {
-  double worst = 0.0;
-  for (const SweepRow& r : rows)
-    worst = std::max(worst, r.target_velocity - dot(relative_velocity(s, r.body_a, r.body_b, r.ra, r.rb), r.normal));
-  return worst;
-}
 
 // The manifolds' points as rows, in sweep order; with the warm start, each point's accumulated
 // impulse applied as it is copied (apply_accumulated_impulses' order and arithmetic).

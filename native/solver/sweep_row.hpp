@@ -5,6 +5,7 @@
 // so that both make the same arithmetic in the same order: the same impulses to the bit.
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "solver/contact_solver.hpp"
 
@@ -45,6 +46,15 @@ namespace floedem {
 /// Applies `impulse` (on the row's body b; its opposite on a) at the row's contact point.
 inline void apply_row_impulse(BodyArrays& s, const SweepRow& r, Vec2 impulse) {
   apply_impulse(s, r.body_a, r.body_b, r.ra, r.rb, impulse);
+}
+
+/// largest_shortfall over rows (the same points in the same order): the largest amount by
+/// which a point approaches faster than its target (m/s, >= 0).
+inline double largest_shortfall_of(std::span<const SweepRow> rows, const BodyArrays& s) {
+  double worst = 0.0;
+  for (const SweepRow& r : rows)
+    worst = std::max(worst, r.target_velocity - dot(relative_velocity(s, r.body_a, r.body_b, r.ra, r.rb), r.normal));
+  return worst;
 }
 
 /// The row's impulse change of one sweep (N s).
