@@ -87,20 +87,20 @@ template <class M>
 void collide_into(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, M& m,
                   SeparationHint* hint) {
   m.point_count = 0;
-  // The last test's best edges first (a pair's two floes turn little in a step). Whichever
-  // test says "apart" first, the answer is the same (no contact), and either polygon's largest
-  // separation is found as without the hint, to the bit (sat.hpp). No hint: the plain search.
+  // The last test's best edges first (a pair's two floes turn little in a step): where either
+  // still separates the pair by more than the margin, the pair is apart (the largest separation
+  // can only be larger) and nothing more is computed. Otherwise both polygons' largest
+  // separations are searched in full (max_face_separation_lanes: the plain search's edge and
+  // separation to the bit), and the hint becomes this test's best edges. The manifold does not
+  // depend on the hint; no hint: the full searches alone.
   SeparationHint none;
   SeparationHint& h = hint ? *hint : none;
-  const bool hint_a = h.a >= 0 && h.a < a.world.count;
-  const bool hint_b = h.b >= 0 && h.b < b.world.count;
-  const double floor_b = hint_b ? edge_separation(b.world, a.world, h.b) : 0.0;
-  if (hint_b && floor_b > margin) return;
-  const FaceSeparation sa = max_face_separation(a.world, b.world, margin, hint_a ? h.a : -1,
-                                                hint_a ? edge_separation(a.world, b.world, h.a) : 0.0);
+  if (h.b >= 0 && h.b < b.world.count && edge_separation(b.world, a.world, h.b) > margin) return;
+  if (h.a >= 0 && h.a < a.world.count && edge_separation(a.world, b.world, h.a) > margin) return;
+  const FaceSeparation sa = max_face_separation_lanes(a.world, b.world);
   h.a = static_cast<std::int16_t>(sa.edge);
   if (sa.separation > margin) return;
-  const FaceSeparation sb = max_face_separation(b.world, a.world, margin, hint_b ? h.b : -1, floor_b);
+  const FaceSeparation sb = max_face_separation_lanes(b.world, a.world);
   h.b = static_cast<std::int16_t>(sb.edge);
   if (sb.separation > margin) return;
 

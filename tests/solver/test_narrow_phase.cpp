@@ -182,6 +182,10 @@ TEST_CASE("narrow phase: the separating axes' shortcuts give the full search's e
     const FaceSeparation full = brute(va, vb), fast = max_face_separation(va, vb);
     REQUIRE(fast.edge == full.edge);
     REQUIRE(fast.separation == full.separation);
+    // The lanes' search (no shortcut, four edges at once): the same, to the bit.
+    const FaceSeparation lanes = max_face_separation_lanes(va, vb);
+    REQUIRE(lanes.edge == full.edge);
+    REQUIRE(std::bit_cast<std::uint64_t>(lanes.separation) == std::bit_cast<std::uint64_t>(full.separation));
     const double enough = 0.5 * u(rng);
     const FaceSeparation cut = max_face_separation(va, vb, enough);
     REQUIRE((cut.separation > enough) == (full.separation > enough));
@@ -236,6 +240,10 @@ TEST_CASE("narrow phase: a pair's separation hint gives the manifold found witho
     for (const auto& [p, q] : {std::pair{va, vb}, std::pair{vb, va}}) {
       const FaceSeparation plain = max_face_separation(p, q);
       const FaceSeparation cut = max_face_separation(p, q, margin);
+      // 3 to 9 corners: every count of edges in the lanes' last group of four, ties included.
+      const FaceSeparation lanes = max_face_separation_lanes(p, q);
+      REQUIRE(lanes.edge == plain.edge);
+      REQUIRE(bits(lanes.separation) == bits(plain.separation));
       for (int i = 0; i < p.count; ++i) {
         const double floor = edge_separation(p, q, i);
         if (floor == plain.separation && i != plain.edge) ++ties;
