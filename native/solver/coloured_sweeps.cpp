@@ -139,43 +139,90 @@ struct SweepResult {
   double largest_change = 0.0, largest_impulse = 0.0, size = 0.0;
 };
 
+// A bundle under way in a sweep: its bodies' velocities, held in registers over its points.
+struct BundleRun {
+  Side a_side, b_side;
+  v4d nx, ny, mu;  // t = perp(n) = (-ny, nx)
+};
+
+FLOEDEM_LANES BundleRun start(const SweepBundle& b, const Vec2* v, const double* w) {
+  return {gather(b.body_a, v, w), gather(b.body_b, v, w), load(b.nx), load(b.ny), load(b.friction)};
+}
+
+// Point k of a bundle: its local solve and impulse. Returns |dP|^2 per lane (NNCG's merit: the
+// caller adds it in point order); with `change` (NNCG), each lane's impulse change into it.
+FLOEDEM_LANES v4d sweep_point(SweepBundle& b, int k, BundleRun& r, v4d& largest_change, v4d& largest_impulse,
+                              double* change) {
+  BundlePoint& p = b.point[k];
+  const v4d nx = r.nx, ny = r.ny;
+  // Relative velocity of b's point with respect to a's: (v_b + w_b k x r_b) - (v_a + w_a k x r_a).
+  const v4d ux = (r.b_side.vx + -r.b_side.w * load(p.rby)) - (r.a_side.vx + -r.a_side.w * load(p.ray));
+  const v4d uy = (r.b_side.vy + r.b_side.w * load(p.rbx)) - (r.a_side.vy + r.a_side.w * load(p.rax));
+  const v4d pn0 = load(p.normal_impulse), pt0 = load(p.tangent_impulse);
+  // Velocity without this point's own impulse.
+  const v4d ufn = (ux * nx + uy * ny) - (load(p.wnn) * pn0 + load(p.wnt) * pt0);
+  const v4d uft = (ux * -ny + uy * nx) - (load(p.wnt) * pn0 + load(p.wtt) * pt0);
+  v4d pn, pt;
+  local_lanes(p, ufn, uft, r.mu, pn, pt);
+  const v4d dpn = pn - pn0, dpt = pt - pt0;
+  apply(b, p, dpn * nx + dpt * -ny, dpn * ny + dpt * nx, r.a_side, r.b_side);
+  store(p.normal_impulse, pn);
+  store(p.tangent_impulse, pt);
+  largest_change = max(largest_change, abs(dpn) + abs(dpt));
+  largest_impulse = max(largest_impulse, pn + abs(pt));
+  if (change == nullptr) return splat(0.0);
+  for (int l = 0; l < kBundleLanes; ++l) {
+    if (b.manifold[l] < 0) continue;
+    double* const c = change + 4 * b.manifold[l] + 2 * k;
+    c[0] = dpn[l];
+    c[1] = dpt[l];
+  }
+  return dpn * dpn + dpt * dpt;
+}
+
+FLOEDEM_LANES void finish(const SweepBundle& b, const BundleRun& r, Vec2* v, double* w) {
+  scatter(b.body_a, b.ma, r.a_side, v, w);
+  scatter(b.body_b, b.mb, r.b_side, v, w);
+}
+
 // One Gauss-Seidel sweep over the bundles, in order; with `change` (NNCG), each point's
-// impulse change into it (4 values a manifold: point, n or t).
+// impulse change into it (4 values a manifold: point, n or t). The bundles are one colour's:
+// no two share a moving body, so the order in which their points are solved does not change
+// what any computes. Two are solved side by side, point k of one beside point k of the other:
+// each bundle's points are one chain of dependent operations (its bodies' velocities), over
+// 300 instructions long, and one chain alone leaves most of the core idle (two chains: see
+// BM_ContactSweepsColoured). Every sum and maximum is formed as one bundle after the other
+// would (|dP|^2 added in bundle and point order; a maximum does not depend on order), so the
+// sweep is the same to the bit as one bundle at a time.
 FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
   v4d largest_change = splat(0.0), largest_impulse = splat(0.0), size = splat(0.0);
-  for (std::size_t i = 0; i < bundles.size(); ++i) {
-    SweepBundle& b = bundles[i];
-    Side a_side = gather(b.body_a, v, w), b_side = gather(b.body_b, v, w);
-    const v4d nx = load(b.nx), ny = load(b.ny), mu = load(b.friction);  // t = perp(n) = (-ny, nx)
-    for (int k = 0; k < b.points; ++k) {
-      BundlePoint& p = b.point[k];
-      // Relative velocity of b's point with respect to a's: (v_b + w_b k x r_b) - (v_a + w_a k x r_a).
-      const v4d ux = (b_side.vx + -b_side.w * load(p.rby)) - (a_side.vx + -a_side.w * load(p.ray));
-      const v4d uy = (b_side.vy + b_side.w * load(p.rbx)) - (a_side.vy + a_side.w * load(p.rax));
-      const v4d pn0 = load(p.normal_impulse), pt0 = load(p.tangent_impulse);
-      // Velocity without this point's own impulse.
-      const v4d ufn = (ux * nx + uy * ny) - (load(p.wnn) * pn0 + load(p.wnt) * pt0);
-      const v4d uft = (ux * -ny + uy * nx) - (load(p.wnt) * pn0 + load(p.wtt) * pt0);
-      v4d pn, pt;
-      local_lanes(p, ufn, uft, mu, pn, pt);
-      const v4d dpn = pn - pn0, dpt = pt - pt0;
-      apply(b, p, dpn * nx + dpt * -ny, dpn * ny + dpt * nx, a_side, b_side);
-      store(p.normal_impulse, pn);
-      store(p.tangent_impulse, pt);
-      largest_change = max(largest_change, abs(dpn) + abs(dpt));
-      largest_impulse = max(largest_impulse, pn + abs(pt));
-      if (change != nullptr) {
-        for (int l = 0; l < kBundleLanes; ++l) {
-          if (b.manifold[l] < 0) continue;
-          double* const c = change + 4 * b.manifold[l] + 2 * k;
-          c[0] = dpn[l];
-          c[1] = dpt[l];
-        }
-        size = size + (dpn * dpn + dpt * dpt);
-      }
+  std::size_t i = 0;
+  for (; i + 1 < bundles.size(); i += 2) {
+    SweepBundle &b0 = bundles[i], &b1 = bundles[i + 1];
+    BundleRun r0 = start(b0, v, w), r1 = start(b1, v, w);
+    v4d sq0[2], sq1[2];
+    const int both = std::min(b0.points, b1.points);
+    for (int k = 0; k < both; ++k) {
+      sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, change);
+      sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, change);
     }
-    scatter(b.body_a, b.ma, a_side, v, w);
-    scatter(b.body_b, b.mb, b_side, v, w);
+    for (int k = both; k < b0.points; ++k) sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, change);
+    for (int k = both; k < b1.points; ++k) sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, change);
+    if (change != nullptr) {
+      for (int k = 0; k < b0.points; ++k) size = size + sq0[k];
+      for (int k = 0; k < b1.points; ++k) size = size + sq1[k];
+    }
+    finish(b0, r0, v, w);
+    finish(b1, r1, v, w);
+  }
+  if (i < bundles.size()) {
+    SweepBundle& b = bundles[i];
+    BundleRun r = start(b, v, w);
+    for (int k = 0; k < b.points; ++k) {
+      const v4d sq = sweep_point(b, k, r, largest_change, largest_impulse, change);
+      if (change != nullptr) size = size + sq;
+    }
+    finish(b, r, v, w);
   }
   SweepResult r;
   for (int l = 0; l < kBundleLanes; ++l) {

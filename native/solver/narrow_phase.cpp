@@ -100,6 +100,11 @@ void collide_into(const PartGeometry& a, const PartGeometry& b, double margin, d
   const FaceSeparation sa = max_face_separation_lanes(a.world, b.world);
   h.a = static_cast<std::int16_t>(sa.edge);
   if (sa.separation > margin) return;
+  // The reference face's frame data (read below) is in arrays the search does not touch, and at
+  // 16k floes mostly out of cache: asked for now, while b's search runs (a's face is the usual
+  // reference). A prefetch only warms the cache: nothing computed changes.
+  __builtin_prefetch(&a.local_normals[sa.edge]);
+  __builtin_prefetch(&a.local_vertices[sa.edge]);
   const FaceSeparation sb = max_face_separation_lanes(b.world, a.world);
   h.b = static_cast<std::int16_t>(sb.edge);
   if (sb.separation > margin) return;
