@@ -365,21 +365,23 @@ bool NativeEngine::outran_reach() {
   // contacts can have changed speed since the reach was set (from the velocities after the
   // loads), and one within both its linear and its angular reach has no part beyond its own:
   // those checks first (the towing case's 5 000 floes cost nothing more where none is struck).
-  for (const Manifold& m : manifolds_)
-    for (const std::int32_t b : {m.body_a, m.body_b}) {
-      if (!moves_[b] || outran_[b]) continue;
-      const double linear = dt_ * length(bodies_.velocity[b]);
-      const double angular = dt_ * std::abs(bodies_.angular_velocity[b]);
-      if (linear <= linear_reach_[b] && angular <= angular_reach_[b]) continue;
-      bool beyond = false;
-      for (std::int32_t k = parts_.first_part(b); k < parts_.first_part(b + 1); ++k)
-        beyond = beyond || linear + angular * parts_.radius(k) > part_reach_[k] + 0.5 * settings_.allowed_penetration;
-      if (!beyond) continue;
-      linear_reach_[b] = std::max(linear_reach_[b], linear);
-      angular_reach_[b] = std::max(angular_reach_[b], angular);
-      outran_[b] = 1;
-      outran_list_.push_back(b);
-    }
+  // Each moving body of a contact once, from the islands the solve just built (a packed floe
+  // has some six contacts: a loop over the manifolds looked at it six times). The bodies found
+  // are the same set in another order, and the reaches widened are the same.
+  for (const std::int32_t b : islands_.all_bodies()) {
+    if (!moves_[b] || outran_[b]) continue;
+    const double linear = dt_ * length(bodies_.velocity[b]);
+    const double angular = dt_ * std::abs(bodies_.angular_velocity[b]);
+    if (linear <= linear_reach_[b] && angular <= angular_reach_[b]) continue;
+    bool beyond = false;
+    for (std::int32_t k = parts_.first_part(b); k < parts_.first_part(b + 1); ++k)
+      beyond = beyond || linear + angular * parts_.radius(k) > part_reach_[k] + 0.5 * settings_.allowed_penetration;
+    if (!beyond) continue;
+    linear_reach_[b] = std::max(linear_reach_[b], linear);
+    angular_reach_[b] = std::max(angular_reach_[b], angular);
+    outran_[b] = 1;
+    outran_list_.push_back(b);
+  }
   return !outran_list_.empty();
 }
 
