@@ -14,7 +14,7 @@ struct ClipVertex {
 };
 
 /// Keeps the part of segment (in[0], in[1]) where dot(normal, p) <= offset.
-int clip_segment(const ClipVertex in[2], ClipVertex out[2], Vec2 normal, double offset, std::uint32_t clip_feature) {
+[[gnu::always_inline]] inline int clip_segment(const ClipVertex in[2], ClipVertex out[2], Vec2 normal, double offset, std::uint32_t clip_feature) {
   int count = 0;
   const double d0 = dot(normal, in[0].p) - offset;
   const double d1 = dot(normal, in[1].p) - offset;
