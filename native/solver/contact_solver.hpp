@@ -164,6 +164,12 @@ struct ProjectionWork {
   std::vector<std::uint64_t> moved;      ///< per body: the evaluation that last changed its pose
   std::vector<std::uint64_t> evaluated;  ///< per manifold: the evaluation that last measured its gaps
   std::vector<double> depth;             ///< ... and the deepest of those gaps then (m, >= 0)
+  // After the first sweep (solve_positions): the manifolds to measure again, as bits, and each
+  // body's manifolds (CSR), so a sweep visits only those and not every manifold.
+  std::vector<std::uint64_t> stale;       ///< per manifold, a bit: a body moved since it was measured
+  std::vector<std::int32_t> body_first;   ///< body b's manifolds are body_manifolds[body_first[b] ...
+  std::vector<std::int32_t> body_manifolds;  ///< ... body_first[b + 1])
+  std::vector<std::int32_t> moved_bodies;  ///< the bodies the first sweep moved (each once)
 };
 
 /// Nonlinear Gauss-Seidel on positions (Box2D v2.4's position solver): pushes overlapping
