@@ -239,7 +239,8 @@ def stages_scaling(rows):
     # on the whole field, whose odds grow with the number of floes.
     why = {"position_projection": "the position projection stops once the deepest overlap of all the step's "
                                   "contacts is within 1.5 times the allowed overlap, so one deep contact anywhere "
-                                  "keeps every contact iterating",
+                                  "keeps the projection sweeping (each later sweep measures only the contacts "
+                                  "whose floes moved, but the first measures every contact)",
            "redetect": "redetect finds and solves all of the step's contacts again when any body the impulses "
                        "sent beyond its reach meets a contact the step did not hold"}
     reasons = [why[k] for k, _ in grown if k in why]
