@@ -403,23 +403,26 @@ double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const
     return depth;
   };
   if (settings.position_iterations <= 0) return 0.0;
+  // The first sweep: every manifold, its two bodies noted as it is read (for the lists below,
+  // which then need not read the manifolds again).
+  resize_with_headroom(work.ends, 2 * nm);
   double deepest = 0.0;
-  for (std::size_t i = 0; i < nm; ++i) deepest = std::max(deepest, measure(i));
+  for (std::size_t i = 0; i < nm; ++i) {
+    work.ends[2 * i] = manifolds[i].body_a;
+    work.ends[2 * i + 1] = manifolds[i].body_b;
+    deepest = std::max(deepest, measure(i));
+  }
   if (settings.position_iterations == 1 || deepest <= 1.5 * settings.allowed_penetration) return deepest;
 
   // Each body's manifolds (counting sort), then the manifolds stale after the first sweep: those
   // with a body it moved at or after their measurement (moved >= evaluated, as the clocks say).
   work.body_first.assign(bodies + 1, 0);
-  for (const Manifold& m : manifolds) {
-    ++work.body_first[static_cast<std::size_t>(m.body_a) + 1];
-    ++work.body_first[static_cast<std::size_t>(m.body_b) + 1];
-  }
+  for (std::size_t e = 0; e < 2 * nm; ++e) ++work.body_first[static_cast<std::size_t>(work.ends[e]) + 1];
   for (std::size_t b = 0; b < bodies; ++b) work.body_first[b + 1] += work.body_first[b];
   resize_with_headroom(work.body_manifolds, 2 * nm);
-  for (std::size_t i = 0; i < nm; ++i)
-    for (const int b : {manifolds[i].body_a, manifolds[i].body_b})
-      work.body_manifolds[static_cast<std::size_t>(work.body_first[static_cast<std::size_t>(b)]++)] =
-          static_cast<std::int32_t>(i);
+  for (std::size_t e = 0; e < 2 * nm; ++e)
+    work.body_manifolds[static_cast<std::size_t>(work.body_first[static_cast<std::size_t>(work.ends[e])]++)] =
+        static_cast<std::int32_t>(e / 2);
   for (std::size_t b = bodies; b > 0; --b) work.body_first[b] = work.body_first[b - 1];  // back to the starts
   work.body_first[0] = 0;
   const std::size_t words = (nm + 63) / 64;

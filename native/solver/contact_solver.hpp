@@ -170,6 +170,7 @@ struct ProjectionWork {
   std::vector<std::int32_t> body_first;   ///< body b's manifolds are body_manifolds[body_first[b] ...
   std::vector<std::int32_t> body_manifolds;  ///< ... body_first[b + 1])
   std::vector<std::int32_t> moved_bodies;  ///< the bodies the first sweep moved (each once)
+  std::vector<std::int32_t> ends;          ///< per manifold, its two bodies (taken by the first sweep)
 };
 
 /// Nonlinear Gauss-Seidel on positions (Box2D v2.4's position solver): pushes overlapping
