@@ -472,7 +472,12 @@ void scatter_bundles(const Selection& m, std::span<const SweepBundle> bundles, s
 // (the pool returns when a colour's blocks are all done: the next colour reads what they
 // wrote). Each block reduces its own maxima and |dP|^2, and the sweep adds the blocks' sums in
 // block order on any number of threads: the same sweep to the bit.
-constexpr std::size_t kBlock = 64;  // bundles: 256 manifolds, about 20 us of a sweep
+constexpr std::size_t kBlock = 64;  // bundles: 256 manifolds, about 5 us of a sweep
+// A colour goes to the pool only with this many blocks or more: the pool's join per colour and
+// sweep costs more than half of a colour of two or three blocks saves (the packed 4k field's
+// colours of about 100 bundles: its contact solve took 2.04 ms on two threads, 1.54 on one).
+// Which thread sweeps a block changes no result, so neither does this bound.
+constexpr std::size_t kPoolBlocks = 4;
 SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, BodyArrays& s, double* change,
                           bool threads) {
   // A colour's blocks' results: the calling thread's list (grown, never shrunk), named by a
@@ -491,7 +496,7 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
     const std::span<SweepBundle> colour =
         bundles.subspan(g.colour_start[c], g.colour_start[c + 1] - g.colour_start[c]);
     if (colour.empty()) break;  // colours are taken lowest first: none after an empty one
-    if (!threads || colour.size() <= kBlock) {
+    if (!threads || colour.size() < kPoolBlocks * kBlock) {
       for (std::size_t b = 0; b < colour.size(); b += kBlock)
         add(sweep_once(colour.subspan(b, std::min(kBlock, colour.size() - b)), v, w, change));
       continue;

@@ -195,7 +195,8 @@ TEST_CASE("coloured sweeps: every build of the sweep gives the same impulses to 
 }
 
 TEST_CASE("coloured sweeps: each colour on the pool's threads, the same impulses to the bit", "[solver][coloured][threads]") {
-  // 4 700 manifolds: colours of up to about 1 200 manifolds, 300 bundles, 5 blocks of 64.
+  // 4 700 manifolds: colours of up to about 1 200 manifolds, 300 bundles, 5 blocks of 64: the
+  // largest go to the pool (4 blocks or more), the rest are swept on the calling thread.
   const bool accelerate = GENERATE(false, true);
   const Pack start = pack(60, 40, 21, true);
   const SweepLimits limits{30, 0.0, 20, 1e-6};
