@@ -1,11 +1,14 @@
 #include "forcing/drag.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
+#include "geometry/lanes4.hpp"
 #include "parallel/thread_pool.hpp"
 
 namespace floedem {
@@ -150,6 +153,7 @@ void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_
   quiet_.push_back(q);
   for (const DragSlab& slab : slabs) calm_ = calm_ && slab.flow.x == 0.0 && slab.flow.y == 0.0;
   if (kind_ == Kind::skin && settings_.reference_speed > 0.0) calm_ = false;
+  lanes_packed_ = false;
   if (entry_of_body_.size() <= body) entry_of_body_.resize(body + 1, -1);
   entry_of_body_[body] = static_cast<std::int32_t>(entries_.size());
   entries_.push_back(e);
@@ -209,7 +213,7 @@ namespace {
 // -ffp-contract=off), so the lanes hold the rule's values to the bit.
 using Pair = double __attribute__((vector_size(16)));
 
-inline Pair sqrt_of(Pair x) {
+[[gnu::always_inline]] inline Pair sqrt_of(Pair x) {
 #if defined(__SSE2__)
   return _mm_sqrt_pd(x);  // correctly rounded, as std::sqrt
 #else
@@ -304,6 +308,257 @@ void DistributedDrag::add_skin_slab_lean(BodySum& sum, const Slab& slab, Vec2 v,
   sum.q = {q0, q1, q2};
 }
 
+namespace {
+// Four floes side by side: lane l of every vector holds a floe of its own, which takes the
+// scalar rule's operations (add_form_slab_lean, add_skin_slab_lean above) in their order on its
+// own points, so each floe's sums are those of the point-by-point rule to the bit (IEEE
+// arithmetic rounds each operation the same in a lane as alone; no fused multiply-add,
+// -ffp-contract=off). A lane past its floe's last edge or triangle adds -0 (x + (-0) = x for
+// every x). One floe's sums are chains of dependent additions (three per point); four floes
+// give the core four chains and a quarter of the instructions per point.
+// Four doubles in one vector (geometry/lanes4.hpp): two SSE2 registers on the x86-64
+// baseline, one AVX register in the AVX2 and AVX-512 builds (picked at run time, as the
+// coloured sweeps' builds).
+using namespace lanes4;
+constexpr int kQuad = 4;
+static_assert(sizeof(v4d) == sizeof(double) * kQuad);
+// Correctly rounded per lane, as std::sqrt: two SSE2 square roots, split and joined in
+// registers (through memory, the 32-byte load of two 16-byte stores waits for both).
+FLOEDEM_LANES v4d sqrt4(v4d x) {
+  const Pair lo = sqrt_of(__builtin_shufflevector(x, x, 0, 1)), hi = sqrt_of(__builtin_shufflevector(x, x, 2, 3));
+  return __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
+}
+
+/// The four floes' state in (and their sums in and out), lane by lane.
+struct LaneIo {
+  double c[kQuad], s[kQuad], vx[kQuad], vy[kQuad], w[kQuad], fx[kQuad], fy[kQuad];
+  double q0[kQuad], q1[kQuad], q2[kQuad];
+};
+
+/// A point's kinematics in four lanes: PointKinematics::at's operations.
+struct LaneKinematics {
+  v4d c, s, fx, fy, vx, vy, w, neg_w;
+  explicit LaneKinematics(const LaneIo& io)
+      : c(load(io.c)), s(load(io.s)), fx(load(io.fx)), fy(load(io.fy)), vx(load(io.vx)), vy(load(io.vy)),
+        w(load(io.w)), neg_w(-load(io.w)) {}
+  template <bool rotational>
+  FLOEDEM_LANES void at(v4d lx, v4d ly, v4d& rx, v4d& ry, v4d& ux, v4d& uy) const {
+    rx = c * lx - s * ly;  // rot.apply
+    ry = s * lx + c * ly;
+    ux = rotational ? fx - (vx + neg_w * ry) : fx - vx;
+    uy = rotational ? fy - (vy + w * rx) : fy - vy;
+  }
+};
+
+// add_form_slab_lean, four floes at once.
+template <bool rotational, class Group, class Slot>
+FLOEDEM_LANES void form_quad(LaneIo& io, const Group& g, const Slot* slot) {
+  const LaneKinematics k(io);
+  const v4d none = splat(-0.0), zero = splat(0.0);
+  v4m count;
+  std::memcpy(&count, g.count.data(), sizeof count);
+  v4d q0 = load(io.q0), q1 = load(io.q1), q2 = load(io.q2);
+  for (std::uint32_t j = 0; j < g.slots; ++j) {
+    const Slot& e = slot[j];
+    const v4d nx0 = load(e.normal_x), ny0 = load(e.normal_y);
+    const v4d nx = k.c * nx0 - k.s * ny0, ny = k.s * nx0 + k.c * ny0;  // rot.apply(normal)
+    const v4m past = v4m{} + static_cast<std::int64_t>(j) >= count;
+    const v4d weight = -load(e.weight);
+    auto point = [&](v4d lx, v4d ly) {
+      v4d rx, ry, ux, uy;
+      k.template at<rotational>(lx, ly, rx, ry, ux, uy);
+      const v4d un = ux * nx + uy * ny;
+      const v4d kun = weight * un;  // -k u.n
+      const v4m leaves = (v4m)(un >= zero) | past;
+      const v4d f_x = select(leaves, none, kun * ux), f_y = select(leaves, none, kun * uy);
+      q0 += f_x;
+      q1 += f_y;
+      if (rotational) q2 += select(leaves, none, rx * f_y - ry * f_x);  // cross(r, f)
+    };
+    point(load(e.first_x), load(e.first_y));
+    point(load(e.second_x), load(e.second_y));
+  }
+  store(io.q0, q0);
+  store(io.q1, q1);
+  store(io.q2, q2);
+}
+
+// add_skin_slab_lean, four floes at once.
+template <bool rotational, class Group, class Slot>
+FLOEDEM_LANES void skin_quad(LaneIo& io, const Group& g, const Slot* slot) {
+  const LaneKinematics k(io);
+  const v4d none = splat(-0.0);
+  v4m count;
+  std::memcpy(&count, g.count.data(), sizeof count);
+  v4d q0 = load(io.q0), q1 = load(io.q1), q2 = load(io.q2);
+  // One point's k |u| u and its moment, as add_skin_point adds them (-0 past the floe's end).
+  auto add = [&](v4m in, v4d rx, v4d ry, v4d ux, v4d uy, v4d m, v4d weight) {
+    const v4d km = weight * m;
+    const v4d f_x = km * ux, f_y = km * uy;
+    q0 += select(in, f_x, none);
+    q1 += select(in, f_y, none);
+    if (rotational) q2 += select(in, rx * f_y - ry * f_x, none);
+  };
+  v4d ax, ay, aux, auy;
+  k.template at<rotational>(load(g.start_x.data()), load(g.start_y.data()), ax, ay, aux, auy);
+  v4d am = sqrt4(aux * aux + auy * auy);  // length(u)
+  for (std::uint32_t j = 0; j < g.slots; ++j) {
+    const Slot& t = slot[j];
+    const v4m in = v4m{} + static_cast<std::int64_t>(j) < count;
+    v4d bx, by, bux, buy, mx, my, mux, muy;
+    k.template at<rotational>(load(t.next_x), load(t.next_y), bx, by, bux, buy);
+    k.template at<rotational>(load(t.middle_x), load(t.middle_y), mx, my, mux, muy);
+    const v4d bm = sqrt4(bux * bux + buy * buy), mm = sqrt4(mux * mux + muy * muy);
+    const v4d weight = load(t.weight);
+    add(in, ax, ay, aux, auy, am, weight);
+    add(in, bx, by, bux, buy, bm, weight);
+    add(in, mx, my, mux, muy, mm, weight);
+    ax = bx, ay = by, aux = bux, auy = buy, am = bm;
+  }
+  store(io.q0, q0);
+  store(io.q1, q1);
+  store(io.q2, q2);
+}
+
+template <class Group, class Slot>
+void form_baseline(LaneIo& io, const Group& g, const Slot* slot, bool rotational) {
+  rotational ? form_quad<true>(io, g, slot) : form_quad<false>(io, g, slot);
+}
+template <class Group, class Slot>
+void skin_baseline(LaneIo& io, const Group& g, const Slot* slot, bool rotational) {
+  rotational ? skin_quad<true>(io, g, slot) : skin_quad<false>(io, g, slot);
+}
+#if defined(__x86_64__)
+#define FLOEDEM_HAS_AVX2_DRAG 1
+template <class Group, class Slot>
+[[gnu::target("avx2")]] void form_avx2(LaneIo& io, const Group& g, const Slot* slot, bool rotational) {
+  rotational ? form_quad<true>(io, g, slot) : form_quad<false>(io, g, slot);
+}
+template <class Group, class Slot>
+[[gnu::target("avx2")]] void skin_avx2(LaneIo& io, const Group& g, const Slot* slot, bool rotational) {
+  rotational ? skin_quad<true>(io, g, slot) : skin_quad<false>(io, g, slot);
+}
+// AVX-512's 32 vector registers (for the same 4-lane vectors) spare the AVX2 build's spills.
+template <class Group, class Slot>
+[[gnu::target("avx2,avx512f,avx512vl")]] void form_avx512(LaneIo& io, const Group& g, const Slot* slot,
+                                                          bool rotational) {
+  rotational ? form_quad<true>(io, g, slot) : form_quad<false>(io, g, slot);
+}
+template <class Group, class Slot>
+[[gnu::target("avx2,avx512f,avx512vl")]] void skin_avx512(LaneIo& io, const Group& g, const Slot* slot,
+                                                          bool rotational) {
+  rotational ? skin_quad<true>(io, g, slot) : skin_quad<false>(io, g, slot);
+}
+#endif
+}  // namespace
+
+std::vector<DistributedDrag::Isa> DistributedDrag::available_isas() {
+#ifdef FLOEDEM_HAS_AVX2_DRAG
+  return available_lane_isas();
+#else
+  return {Isa::baseline};
+#endif
+}
+
+namespace {
+std::atomic<DistributedDrag::Isa> lane_isa{DistributedDrag::available_isas().back()};
+}  // namespace
+
+void DistributedDrag::use_isa(Isa isa) {
+  const std::vector<Isa> isas = available_isas();
+  lane_isa.store(std::find(isas.begin(), isas.end(), isa) != isas.end() ? isa : isas.back());
+}
+
+void DistributedDrag::pack_lanes() const {
+  groups_.clear();
+  form_lanes_.clear();
+  skin_lanes_.clear();
+  in_lanes_.assign(entries_.size(), 0);
+  laned_.assign(entries_.size(), 0);
+  lanes_packed_ = true;
+  if (settings_.reference_speed > 0.0) return;  // linearised drag never takes the lean path
+  // The entries of one slab (floes), in windows of 64 in entry order (bodies near in memory),
+  // each window sorted by its entries' points so that a group's lanes end about together.
+  std::vector<std::uint32_t> single;
+  for (std::size_t i = 0; i < entries_.size(); ++i)
+    if (entries_[i].slab_count == 1) single.push_back(static_cast<std::uint32_t>(i));
+  auto points = [&](std::uint32_t i) { return slabs_[entries_[i].first_slab].count; };
+  constexpr std::size_t kWindow = 64;
+  for (std::size_t w = 0; w < single.size(); w += kWindow)
+    std::stable_sort(single.begin() + static_cast<std::ptrdiff_t>(w),
+                     single.begin() + static_cast<std::ptrdiff_t>(std::min(single.size(), w + kWindow)),
+                     [&](std::uint32_t a, std::uint32_t b) { return points(a) < points(b); });
+  for (std::size_t k = 0; k < single.size(); k += kLanes) {
+    LaneGroup g;
+    g.lanes = static_cast<std::uint32_t>(std::min<std::size_t>(kLanes, single.size() - k));
+    for (std::uint32_t l = 0; l < g.lanes; ++l) g.slots = std::max(g.slots, points(single[k + l]));
+    g.first = static_cast<std::uint32_t>(kind_ == Kind::form ? form_lanes_.size() : skin_lanes_.size());
+    if (kind_ == Kind::form)
+      form_lanes_.resize(form_lanes_.size() + g.slots, FormSlot{});
+    else
+      skin_lanes_.resize(skin_lanes_.size() + g.slots, SkinSlot{});
+    for (std::uint32_t l = 0; l < kLanes; ++l) {
+      const std::uint32_t i = single[k + (l < g.lanes ? l : 0)];
+      g.entry[l] = i;
+      if (l >= g.lanes) continue;  // read as lane 0, never stored
+      laned_[i] = 1;
+      const Slab& slab = slabs_[entries_[i].first_slab];
+      g.count[l] = slab.count;
+      g.flow_x[l] = slab.drag.flow.x;
+      g.flow_y[l] = slab.drag.flow.y;
+      for (std::uint32_t j = 0; j < slab.count; ++j) {
+        if (kind_ == Kind::form) {
+          const FormEdge& e = form_[slab.first + j];
+          FormSlot& o = form_lanes_[g.first + j];
+          o.first_x[l] = e.first.x, o.first_y[l] = e.first.y;
+          o.second_x[l] = e.second.x, o.second_y[l] = e.second.y;
+          o.normal_x[l] = e.normal.x, o.normal_y[l] = e.normal.y;
+          o.weight[l] = e.weight;
+        } else {
+          const SkinTriangle* t = skin_.data() + slab.first;
+          const Vec2 next = j + 1 < slab.count ? t[j + 1].half_vertex : t[0].half_vertex;
+          SkinSlot& o = skin_lanes_[g.first + j];
+          o.next_x[l] = next.x, o.next_y[l] = next.y;
+          o.middle_x[l] = t[j].middle.x, o.middle_y[l] = t[j].middle.y;
+          o.weight[l] = t[j].weight;
+          if (j == 0) g.start_x[l] = t[0].half_vertex.x, g.start_y[l] = t[0].half_vertex.y;
+        }
+      }
+    }
+    groups_.push_back(g);
+  }
+}
+
+void DistributedDrag::add_group(const LaneGroup& g, unsigned mask, const BodyStatesView& s, ForceSums& sums) const {
+  LaneIo io;
+  for (int l = 0; l < kLanes; ++l) {
+    const std::size_t body = quiet_[g.entry[l]].body;
+    const Rot rot = sums.rotation[body];
+    io.c[l] = rot.c, io.s[l] = rot.s;
+    io.vx[l] = s.velocity[body].x, io.vy[l] = s.velocity[body].y;
+    io.w[l] = s.angular_velocity[body];
+    io.fx[l] = g.flow_x[l], io.fy[l] = g.flow_y[l];
+    io.q0[l] = sums.q[body][0], io.q1[l] = sums.q[body][1], io.q2[l] = sums.q[body][2];
+  }
+  const bool rotational = settings_.rotational;
+  // The group's slots: in form_lanes_ for form drag, in skin_lanes_ for skin drag (the other empty).
+  const FormSlot* form = kind_ == Kind::form ? form_lanes_.data() + g.first : nullptr;
+  const SkinSlot* skin = kind_ == Kind::skin ? skin_lanes_.data() + g.first : nullptr;
+  switch (lane_isa.load(std::memory_order_relaxed)) {
+#ifdef FLOEDEM_HAS_AVX2_DRAG
+    case Isa::avx512:
+      kind_ == Kind::form ? form_avx512(io, g, form, rotational) : skin_avx512(io, g, skin, rotational);
+      break;
+    case Isa::avx2:
+      kind_ == Kind::form ? form_avx2(io, g, form, rotational) : skin_avx2(io, g, skin, rotational);
+      break;
+#endif
+    default: kind_ == Kind::form ? form_baseline(io, g, form, rotational) : skin_baseline(io, g, skin, rotational);
+  }
+  for (int l = 0; l < kLanes; ++l)
+    if (mask & (1u << l)) sums.q[quiet_[g.entry[l]].body] = {io.q0[l], io.q1[l], io.q2[l]};
+}
+
 template <class F>
 void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& f) const {
   if (!calm_) {
@@ -383,12 +638,27 @@ bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
 void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) const {
   // Entries are bodies, one each: blocks of them on the pool's threads write distinct bodies,
   // each in the same order as one thread would, so the sums do not depend on the threads.
+  // The floes that take the lean path are left to the lanes (add_entry marks them), which then
+  // add them four at a time: each body's sums are written once, by one of the two loops.
+  if (!lanes_packed_) pack_lanes();
   std::atomic<bool> any_jacobian{false};
   for_entries(sums, 512, [&](std::size_t i) {
     if (add_entry(i, s, sums) && !any_jacobian.load(std::memory_order_relaxed))
       any_jacobian.store(true, std::memory_order_relaxed);
   });
   if (any_jacobian.load(std::memory_order_relaxed)) sums.any_jacobian = true;
+  thread_pool().for_blocks(groups_.size(), 128, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const LaneGroup& g = groups_[k];
+      unsigned mask = 0;
+      for (std::uint32_t l = 0; l < g.lanes; ++l)
+        if (in_lanes_[g.entry[l]] != 0) {
+          mask |= 1u << l;
+          in_lanes_[g.entry[l]] = 0;
+        }
+      if (mask != 0) add_group(g, mask, s, sums);
+    }
+  });
 }
 
 bool DistributedDrag::add_entry(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {
@@ -397,8 +667,12 @@ bool DistributedDrag::add_entry(std::size_t i, const BodyStatesView& s, ForceSum
   const double w = s.angular_velocity[body];
   if (adds_nothing(i, v, w)) return false;
   const Entry& e = entries_[i];
-  const Rot rot = sums.rotation[e.body];
   const bool jacobian = sums.jacobian[e.body] != 0;
+  if (!jacobian && laned_[i] != 0) {  // quadratic drag on a floe, Q alone: four at a time (add)
+    in_lanes_[i] = 1;
+    return false;
+  }
+  const Rot rot = sums.rotation[e.body];
   BodySum sum = sums.load(e.body);
   for (std::uint32_t k = 0; k < e.slab_count; ++k) {
     const Slab& slab = slabs_[e.first_slab + k];

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "forcing/force_term.hpp"
+#include "geometry/lane_isa.hpp"
 
 namespace floedem {
 
@@ -68,6 +69,14 @@ class DistributedDrag final : public ForceTerm {
   bool add_rate_bound(const BodyStatesView& state, ForceSums& sums) const override;
   bool reads_stirred() const override { return calm_; }
   bool idle_at_rest() const override { return calm_; }
+  /// The builds of the four-floe lanes (drag.cpp): the x86-64 baseline, AVX2, and AVX2 with
+  /// AVX-512's 32 registers. The same sums to the bit in each (tested); the fastest the
+  /// processor runs is used unless a test or a benchmark asks for another.
+  using Isa = LaneIsa;
+  /// Those this processor runs, slowest first.
+  static std::vector<Isa> available_isas();
+  /// The build every drag term uses from now on (one this processor runs; else the fastest).
+  static void use_isa(Isa isa);
 
  private:
   // Packed quadrature, read every step: the same points, weights and order as edge_points /
@@ -110,6 +119,27 @@ class DistributedDrag final : public ForceTerm {
   /// the pool's threads.
   template <class F>
   void for_entries(const ForceSums& sums, std::size_t grain, F&& f) const;
+  /// Four floes side by side (drag.cpp): entries of one slab each, in groups of four, their
+  /// points transposed so that slot j holds each lane's j-th edge or triangle. Packed on the
+  /// first add after the last add_body.
+  static constexpr int kLanes = 4;
+  struct LaneGroup {
+    std::array<std::uint32_t, kLanes> entry{};  // lanes past `lanes` repeat lane 0's
+    std::array<std::int64_t, kLanes> count{};   // each lane's edges or triangles (0 past `lanes`)
+    std::array<double, kLanes> flow_x{}, flow_y{};
+    std::array<double, kLanes> start_x{}, start_y{};  // skin: the first half-vertex
+    std::uint32_t first = 0, slots = 0, lanes = 0;    // its slots in form_lanes_ or skin_lanes_
+  };
+  struct FormSlot {
+    double first_x[kLanes], first_y[kLanes], second_x[kLanes], second_y[kLanes];
+    double normal_x[kLanes], normal_y[kLanes], weight[kLanes];
+  };
+  struct SkinSlot {
+    double next_x[kLanes], next_y[kLanes];  // the triangle's second half-vertex (the next one's first)
+    double middle_x[kLanes], middle_y[kLanes], weight[kLanes];
+  };
+  void pack_lanes() const;
+  void add_group(const LaneGroup& g, unsigned mask, const BodyStatesView& state, ForceSums& sums) const;
   struct Quiet {
     std::size_t body;
     Vec2 flow;      // the slabs' flow, when they share one
@@ -130,6 +160,12 @@ class DistributedDrag final : public ForceTerm {
   // a body at rest adds exactly nothing (adds_nothing), so only moving bodies are visited.
   bool calm_ = true;
   std::vector<std::int32_t> entry_of_body_;  // -1: the body has no entry
+  // The lanes (pack_lanes), and per entry whether this step's add left it to them.
+  mutable bool lanes_packed_ = false;
+  mutable std::vector<LaneGroup> groups_;
+  mutable std::vector<FormSlot> form_lanes_;
+  mutable std::vector<SkinSlot> skin_lanes_;
+  mutable std::vector<std::uint8_t> in_lanes_, laned_;  // laned_: the entry has a lane
 };
 
 /// The term, or nullptr when no body needs it.

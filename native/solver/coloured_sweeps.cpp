@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "geometry/lanes4.hpp"
 #include "parallel/thread_pool.hpp"
 #include "solver/sweep_row.hpp"
 
@@ -22,29 +23,9 @@ namespace floedem {
 
 namespace {
 
-// Four doubles in one vector (GCC and Clang vector extensions): two SSE2 registers on the
-// x86-64 baseline, one AVX register in the AVX2 build of the sweep (sweep_avx2 below). Masks
-// are 64-bit lanes of all ones (true) or zeros.
-using v4d = double __attribute__((vector_size(8 * kBundleLanes)));
-using v4m = std::int64_t __attribute__((vector_size(8 * kBundleLanes)));
-
-#define FLOEDEM_LANES [[gnu::always_inline]] inline
-
-FLOEDEM_LANES v4d load(const double* p) {
-  v4d v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-FLOEDEM_LANES void store(double* p, v4d v) { std::memcpy(p, &v, sizeof v); }
-FLOEDEM_LANES v4d splat(double x) { return v4d{} + x; }
-// Per lane: a where the mask holds, else b.
-FLOEDEM_LANES v4d select(v4m m, v4d a, v4d b) { return (v4d)((m & (v4m)a) | (~m & (v4m)b)); }
-FLOEDEM_LANES v4d abs(v4d x) {
-  constexpr std::int64_t magnitude = std::numeric_limits<std::int64_t>::max();
-  return (v4d)((v4m)x & magnitude);
-}
-// std::max(a, b) per lane: (a < b) ? b : a.
-FLOEDEM_LANES v4d max(v4d a, v4d b) { return select((v4m)(a < b), b, a); }
+// Four doubles in one vector (geometry/lanes4.hpp): a bundle's four manifolds, lane by lane.
+using namespace lanes4;
+static_assert(sizeof(v4d) == sizeof(double) * kBundleLanes);
 
 // The velocities of the bundle's bodies on one side, held in registers over its points.
 struct Side {
@@ -560,14 +541,11 @@ std::size_t colour_manifolds(std::span<Manifold> manifolds, std::span<const std:
 }
 
 std::vector<SweepIsa> available_sweep_isas() {
-  std::vector<SweepIsa> isas{SweepIsa::baseline};
 #ifdef FLOEDEM_HAS_AVX2_SWEEP
-  __builtin_cpu_init();  // called from a static initialiser too
-  if (__builtin_cpu_supports("avx2")) isas.push_back(SweepIsa::avx2);
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl"))
-    isas.push_back(SweepIsa::avx512);
+  return available_lane_isas();
+#else
+  return {SweepIsa::baseline};
 #endif
-  return isas;
 }
 
 void use_sweep_isa(SweepIsa isa) {

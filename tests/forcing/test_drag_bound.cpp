@@ -191,3 +191,86 @@ TEST_CASE("forcing: in still water with Coriolis the moving bodies alone give ev
     }
   }
 }
+
+TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit, in every build",
+          "[forcing]") {
+  // 37 floes (nine groups of four and one lane more), 3 to 9 corners, some with a zero-length
+  // edge, in one term: most take the four-floe lanes (one slab, no Jacobian, quadratic drag);
+  // some need the Jacobian, some have two slabs, and in still water some are at rest and not
+  // visited. Each floe's sums, started from another term's, must be the point-by-point rule's
+  // to the bit, over two steps (the lanes' marks of the first must not leak into the second).
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  constexpr std::size_t n = 37;
+  int lean_checked = 0;
+  for (const DistributedDrag::Isa isa : DistributedDrag::available_isas()) {
+    DistributedDrag::use_isa(isa);
+    for (const bool rotational : {true, false})
+      for (const bool still : {false, true})
+        for (const auto kind : {DistributedDrag::Kind::form, DistributedDrag::Kind::skin}) {
+          INFO("isa " << static_cast<int>(isa) << " rotational " << rotational << " still " << still << " form "
+                      << (kind == DistributedDrag::Kind::form));
+          EnvironmentSpec env;
+          env.rotational_damping = rotational;
+          DistributedDrag drag("lanes", kind, env);
+          std::vector<std::vector<Vec2>> polys(n);
+          std::vector<std::vector<DragSlab>> slabs(n);
+          for (std::size_t i = 0; i < n; ++i) {
+            const int corners = 3 + static_cast<int>((i * 5) % 7);
+            const double size = 2.5 + 14.0 * (1.0 + u(rng));
+            for (int k = 0; k < corners; ++k) {
+              const double a = 2.0 * M_PI * (k + 0.3 * u(rng)) / corners;
+              polys[i].push_back({size * std::cos(a), size * std::sin(a)});
+            }
+            const Vec2 c = area_moments(polys[i]).centroid;
+            for (Vec2& p : polys[i]) p = p - c;
+            if (i % 9 == 4) polys[i].insert(polys[i].begin() + 1, polys[i][1]);  // a zero-length edge
+            const Vec2 flow = still ? Vec2{} : Vec2{0.5 * u(rng), 0.5 * u(rng)};
+            slabs[i].push_back({300.0 * (1.0 + u(rng)), 0.6 + 0.3 * u(rng), flow});
+            if (i % 11 == 7) slabs[i].push_back({40.0, 1.0, still ? Vec2{} : Vec2{u(rng), u(rng)}});  // a keel
+            drag.add_body(i, polys[i], slabs[i]);
+          }
+          for (int step = 0; step < 2; ++step) {
+            INFO("step " << step);
+            BodyStates s;
+            s.resize(n);
+            ForceSums sums = sums_for(n);
+            sums.stirred.clear();
+            for (std::size_t i = 0; i < n; ++i) {
+              const bool rests = still && (i + static_cast<std::size_t>(step)) % 6 == 2;
+              s.velocity[i] = rests ? Vec2{} : Vec2{0.8 * u(rng), 0.8 * u(rng)};
+              s.angular_velocity[i] = rests ? 0.0 : 0.02 * u(rng);
+              s.angle[i] = M_PI * u(rng);
+              sums.rotation[i] = Rot::from_angle(s.angle[i]);
+              sums.jacobian[i] = (i + static_cast<std::size_t>(step)) % 8 == 5 ? 1 : 0;
+              sums.q[i] = {1e3 * u(rng), 1e3 * u(rng), 1e4 * u(rng)};  // another term's sums
+              if (!rests) sums.stirred.push_back(static_cast<std::int32_t>(i));
+            }
+            const ForceSums before = sums;
+            drag.add(s, 0.0, sums);
+            for (std::size_t i = 0; i < n; ++i) {
+              INFO("floe " << i);
+              BodySum rule{before.q[i], before.dq[i]};
+              const bool visited = !still || s.velocity[i].x != 0.0 || s.angular_velocity[i] != 0.0;
+              if (visited)
+                for (const DragSlab& slab : slabs[i]) {
+                  const DragSettings settings{rotational, 0.0};
+                  if (kind == DistributedDrag::Kind::form)
+                    add_form_drag(rule, edge_points(polys[i]), slab.scale, slab.c, slab.flow, s.velocity[i],
+                                  s.angular_velocity[i], sums.rotation[i], settings, true);
+                  else
+                    add_skin_drag(rule, area_points(polys[i]), slab.scale, slab.c, slab.flow, s.velocity[i],
+                                  s.angular_velocity[i], sums.rotation[i], settings, true);
+                }
+              for (int k = 0; k < 3; ++k)  // to the bit: == would take -0 for +0
+                CHECK(std::bit_cast<std::uint64_t>(sums.q[i][k]) == std::bit_cast<std::uint64_t>(rule.q[k]));
+              if (sums.jacobian[i] != 0) CHECK(sums.dq[i] == rule.d);
+              else CHECK(sums.dq[i] == before.dq[i]);  // Q alone: D left as it was
+              if (visited && sums.jacobian[i] == 0 && slabs[i].size() == 1) ++lean_checked;
+            }
+          }
+        }
+  }
+  DistributedDrag::use_isa(DistributedDrag::available_isas().back());
+  CHECK(lean_checked >= 8 * 2 * 20);  // the lanes took most floes in every case
+}

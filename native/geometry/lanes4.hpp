@@ -1,0 +1,37 @@
+#pragma once
+// Four doubles in one vector (GCC and Clang vector extensions): two SSE2 registers on the
+// x86-64 baseline, one AVX register where a function is built for AVX2 or AVX-512. The SIMD
+// loops of the coloured sweeps (solver/coloured_sweeps.cpp) and of drag (forcing/drag.cpp)
+// compute with these, lane by lane, each lane the scalar rule's IEEE operations in its order
+// (-ffp-contract=off), so a lane holds the scalar result to the bit. Masks are 64-bit lanes
+// of all ones (true) or zeros, as a comparison of two v4d gives them.
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+#include "geometry/lane_isa.hpp"
+
+namespace floedem::lanes4 {
+
+using v4d = double __attribute__((vector_size(32)));
+using v4m = std::int64_t __attribute__((vector_size(32)));
+
+#define FLOEDEM_LANES [[gnu::always_inline]] inline
+
+FLOEDEM_LANES v4d load(const double* p) {
+  v4d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+FLOEDEM_LANES void store(double* p, v4d v) { std::memcpy(p, &v, sizeof v); }
+FLOEDEM_LANES v4d splat(double x) { return v4d{} + x; }
+// Per lane: a where the mask holds, else b.
+FLOEDEM_LANES v4d select(v4m m, v4d a, v4d b) { return (v4d)((m & (v4m)a) | (~m & (v4m)b)); }
+FLOEDEM_LANES v4d abs(v4d x) {
+  constexpr std::int64_t magnitude = std::numeric_limits<std::int64_t>::max();
+  return (v4d)((v4m)x & magnitude);
+}
+// std::max(a, b) per lane: (a < b) ? b : a.
+FLOEDEM_LANES v4d max(v4d a, v4d b) { return select((v4m)(a < b), b, a); }
+
+}  // namespace floedem::lanes4
