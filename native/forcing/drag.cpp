@@ -329,18 +329,34 @@ FLOEDEM_LANES v4d sqrt4(v4d x) {
   return __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
 }
 
-/// The four floes' state in (and their sums in and out), lane by lane.
+/// Where the four floes' state is (their bodies' entries in the state and the sums), and
+/// their sums out, lane by lane.
 struct LaneIo {
-  double c[kQuad], s[kQuad], vx[kQuad], vy[kQuad], w[kQuad], fx[kQuad], fy[kQuad];
-  double q0[kQuad], q1[kQuad], q2[kQuad];
+  const Vec2* v;
+  const double* w;
+  const Rot* rot;
+  const std::array<double, 3>* q;
+  std::size_t body[kQuad];
+  double q0[kQuad], q1[kQuad], q2[kQuad];  // out
+  template <class F>
+  FLOEDEM_LANES v4d gather(F&& f) const {
+    return lanes(f(body[0]), f(body[1]), f(body[2]), f(body[3]));
+  }
 };
 
 /// A point's kinematics in four lanes: PointKinematics::at's operations.
 struct LaneKinematics {
   v4d c, s, fx, fy, vx, vy, w, neg_w;
-  explicit LaneKinematics(const LaneIo& io)
-      : c(load(io.c)), s(load(io.s)), fx(load(io.fx)), fy(load(io.fy)), vx(load(io.vx)), vy(load(io.vy)),
-        w(load(io.w)), neg_w(-load(io.w)) {}
+  template <class Group>
+  LaneKinematics(const LaneIo& io, const Group& g)
+      : c(io.gather([&](std::size_t b) { return io.rot[b].c; })),
+        s(io.gather([&](std::size_t b) { return io.rot[b].s; })),
+        fx(load(g.flow_x.data())),
+        fy(load(g.flow_y.data())),
+        vx(io.gather([&](std::size_t b) { return io.v[b].x; })),
+        vy(io.gather([&](std::size_t b) { return io.v[b].y; })),
+        w(io.gather([&](std::size_t b) { return io.w[b]; })),
+        neg_w(-w) {}
   template <bool rotational>
   FLOEDEM_LANES void at(v4d lx, v4d ly, v4d& rx, v4d& ry, v4d& ux, v4d& uy) const {
     rx = c * lx - s * ly;  // rot.apply
@@ -353,11 +369,13 @@ struct LaneKinematics {
 // add_form_slab_lean, four floes at once.
 template <bool rotational, class Group, class Slot>
 FLOEDEM_LANES void form_quad(LaneIo& io, const Group& g, const Slot* slot) {
-  const LaneKinematics k(io);
+  const LaneKinematics k(io, g);
   const v4d none = splat(-0.0), zero = splat(0.0);
   v4m count;
   std::memcpy(&count, g.count.data(), sizeof count);
-  v4d q0 = load(io.q0), q1 = load(io.q1), q2 = load(io.q2);
+  v4d q0 = io.gather([&](std::size_t b) { return io.q[b][0]; });
+  v4d q1 = io.gather([&](std::size_t b) { return io.q[b][1]; });
+  v4d q2 = io.gather([&](std::size_t b) { return io.q[b][2]; });
   for (std::uint32_t j = 0; j < g.slots; ++j) {
     const Slot& e = slot[j];
     const v4d nx0 = load(e.normal_x), ny0 = load(e.normal_y);
@@ -386,11 +404,13 @@ FLOEDEM_LANES void form_quad(LaneIo& io, const Group& g, const Slot* slot) {
 // add_skin_slab_lean, four floes at once.
 template <bool rotational, class Group, class Slot>
 FLOEDEM_LANES void skin_quad(LaneIo& io, const Group& g, const Slot* slot) {
-  const LaneKinematics k(io);
+  const LaneKinematics k(io, g);
   const v4d none = splat(-0.0);
   v4m count;
   std::memcpy(&count, g.count.data(), sizeof count);
-  v4d q0 = load(io.q0), q1 = load(io.q1), q2 = load(io.q2);
+  v4d q0 = io.gather([&](std::size_t b) { return io.q[b][0]; });
+  v4d q1 = io.gather([&](std::size_t b) { return io.q[b][1]; });
+  v4d q2 = io.gather([&](std::size_t b) { return io.q[b][2]; });
   // One point's k |u| u and its moment, as add_skin_point adds them (-0 past the floe's end).
   auto add = [&](v4m in, v4d rx, v4d ry, v4d ux, v4d uy, v4d m, v4d weight) {
     const v4d km = weight * m;
@@ -451,23 +471,6 @@ template <class Group, class Slot>
 }
 #endif
 }  // namespace
-
-std::vector<DistributedDrag::Isa> DistributedDrag::available_isas() {
-#ifdef FLOEDEM_HAS_AVX2_DRAG
-  return available_lane_isas();
-#else
-  return {Isa::baseline};
-#endif
-}
-
-namespace {
-std::atomic<DistributedDrag::Isa> lane_isa{DistributedDrag::available_isas().back()};
-}  // namespace
-
-void DistributedDrag::use_isa(Isa isa) {
-  const std::vector<Isa> isas = available_isas();
-  lane_isa.store(std::find(isas.begin(), isas.end(), isa) != isas.end() ? isa : isas.back());
-}
 
 void DistributedDrag::pack_lanes() const {
   groups_.clear();
@@ -530,33 +533,25 @@ void DistributedDrag::pack_lanes() const {
 }
 
 void DistributedDrag::add_group(const LaneGroup& g, unsigned mask, const BodyStatesView& s, ForceSums& sums) const {
-  LaneIo io;
-  for (int l = 0; l < kLanes; ++l) {
-    const std::size_t body = quiet_[g.entry[l]].body;
-    const Rot rot = sums.rotation[body];
-    io.c[l] = rot.c, io.s[l] = rot.s;
-    io.vx[l] = s.velocity[body].x, io.vy[l] = s.velocity[body].y;
-    io.w[l] = s.angular_velocity[body];
-    io.fx[l] = g.flow_x[l], io.fy[l] = g.flow_y[l];
-    io.q0[l] = sums.q[body][0], io.q1[l] = sums.q[body][1], io.q2[l] = sums.q[body][2];
-  }
+  LaneIo io{s.velocity.data(), s.angular_velocity.data(), sums.rotation.data(), sums.q.data(), {}, {}, {}, {}};
+  for (int l = 0; l < kLanes; ++l) io.body[l] = quiet_[g.entry[l]].body;
   const bool rotational = settings_.rotational;
   // The group's slots: in form_lanes_ for form drag, in skin_lanes_ for skin drag (the other empty).
   const FormSlot* form = kind_ == Kind::form ? form_lanes_.data() + g.first : nullptr;
   const SkinSlot* skin = kind_ == Kind::skin ? skin_lanes_.data() + g.first : nullptr;
-  switch (lane_isa.load(std::memory_order_relaxed)) {
+  switch (lane_isa()) {
 #ifdef FLOEDEM_HAS_AVX2_DRAG
-    case Isa::avx512:
+    case LaneIsa::avx512:
       kind_ == Kind::form ? form_avx512(io, g, form, rotational) : skin_avx512(io, g, skin, rotational);
       break;
-    case Isa::avx2:
+    case LaneIsa::avx2:
       kind_ == Kind::form ? form_avx2(io, g, form, rotational) : skin_avx2(io, g, skin, rotational);
       break;
 #endif
     default: kind_ == Kind::form ? form_baseline(io, g, form, rotational) : skin_baseline(io, g, skin, rotational);
   }
   for (int l = 0; l < kLanes; ++l)
-    if (mask & (1u << l)) sums.q[quiet_[g.entry[l]].body] = {io.q0[l], io.q1[l], io.q2[l]};
+    if (mask & (1u << l)) sums.q[io.body[l]] = {io.q0[l], io.q1[l], io.q2[l]};
 }
 
 template <class F>

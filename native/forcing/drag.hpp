@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "forcing/force_term.hpp"
-#include "geometry/lane_isa.hpp"
 
 namespace floedem {
 
@@ -69,14 +68,6 @@ class DistributedDrag final : public ForceTerm {
   bool add_rate_bound(const BodyStatesView& state, ForceSums& sums) const override;
   bool reads_stirred() const override { return calm_; }
   bool idle_at_rest() const override { return calm_; }
-  /// The builds of the four-floe lanes (drag.cpp): the x86-64 baseline, AVX2, and AVX2 with
-  /// AVX-512's 32 registers. The same sums to the bit in each (tested); the fastest the
-  /// processor runs is used unless a test or a benchmark asks for another.
-  using Isa = LaneIsa;
-  /// Those this processor runs, slowest first.
-  static std::vector<Isa> available_isas();
-  /// The build every drag term uses from now on (one this processor runs; else the fastest).
-  static void use_isa(Isa isa);
 
  private:
   // Packed quadrature, read every step: the same points, weights and order as edge_points /

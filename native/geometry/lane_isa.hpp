@@ -1,24 +1,24 @@
 #pragma once
-// The instruction sets a SIMD loop of floedem (geometry/lanes4.hpp) is built for, picked at
-// run time: the coloured sweeps and the drag's four-floe lanes.
+// The instruction sets floedem's SIMD loops are built for, one of them picked at run time for
+// all: the coloured sweeps (solver/coloured_sweeps.cpp), the narrow phase's separating-axis
+// search (solver/narrow_phase.cpp) and the drag's four-floe lanes (forcing/drag.cpp). Each
+// build takes the same IEEE operations in the same order (no fused multiply-add:
+// -ffp-contract=off), so results are the same to the bit whichever runs (tested per loop).
 #include <vector>
 
 namespace floedem {
 
-/// The builds of such a loop: the x86-64 baseline (SSE2), AVX2, and AVX2 with AVX-512's 32
-/// registers (for the same 4-lane vectors: fewer spills). The same results to the bit in each.
+/// The x86-64 baseline (SSE2), AVX2, and AVX2 with AVX-512's 32 registers (for the same
+/// 4-lane vectors: fewer spills).
 enum class LaneIsa { baseline, avx2, avx512 };
 
 /// The builds this processor runs, slowest first (only the baseline off x86-64).
-inline std::vector<LaneIsa> available_lane_isas() {
-  std::vector<LaneIsa> isas{LaneIsa::baseline};
-#if defined(__x86_64__)
-  __builtin_cpu_init();  // may be called from a static initialiser
-  if (__builtin_cpu_supports("avx2")) isas.push_back(LaneIsa::avx2);
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl"))
-    isas.push_back(LaneIsa::avx512);
-#endif
-  return isas;
-}
+std::vector<LaneIsa> available_lane_isas();
+/// The build every SIMD loop uses: the fastest available unless a test or benchmark set another.
+LaneIsa lane_isa();
+/// Sets it; throws std::invalid_argument for one this processor does not run.
+void use_lane_isa(LaneIsa isa);
+/// Back to the fastest.
+void use_fastest_lane_isa();
 
 }  // namespace floedem

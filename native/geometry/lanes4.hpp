@@ -25,6 +25,15 @@ FLOEDEM_LANES v4d load(const double* p) {
 }
 FLOEDEM_LANES void store(double* p, v4d v) { std::memcpy(p, &v, sizeof v); }
 FLOEDEM_LANES v4d splat(double x) { return v4d{} + x; }
+// Four lanes from four places, as two pairs joined: built as v4d{a, b, c, d}, GCC 12 loads
+// each lane into the register that held the previous vector (vmovlpd merges), a false
+// dependence that chains each vector to the one before it. (Four scalar stores read back as
+// one vector instead wait for all four: the store cannot be forwarded.)
+using v2d = double __attribute__((vector_size(16)));
+FLOEDEM_LANES v4d lanes(double a, double b, double c, double d) {
+  const v2d low{a, b}, high{c, d};
+  return __builtin_shufflevector(low, high, 0, 1, 2, 3);
+}
 // Per lane: a where the mask holds, else b.
 FLOEDEM_LANES v4d select(v4m m, v4d a, v4d b) { return (v4d)((m & (v4m)a) | (~m & (v4m)b)); }
 FLOEDEM_LANES v4d abs(v4d x) {

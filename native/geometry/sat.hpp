@@ -87,7 +87,7 @@ inline FaceSeparation max_face_separation(const ConvexView& a, const ConvexView&
 /// the last edge repeat edge 0 and are not read. The narrow phase's search: at a packed
 /// field's pairs the shortcuts' branches, taken or not by the data, cost more than the products
 /// they save (BM_NarrowPhase). Elsewhere, the plain loop.
-inline FaceSeparation max_face_separation_lanes(const ConvexView& a, const ConvexView& b) {
+[[gnu::always_inline]] inline FaceSeparation max_face_separation_lanes(const ConvexView& a, const ConvexView& b) {
 #if defined(__SSE2__)
   FaceSeparation best;
   const Vec2 *v = a.vertices, *n = a.normals;

@@ -32,14 +32,6 @@ struct Side {
   v4d vx, vy, w;
 };
 
-// Four lanes from four places, as two pairs joined: built as v4d{a, b, c, d}, GCC 12 loads
-// each lane into the register that held the previous bundle's vector (vmovlpd merges), a
-// false dependence that chains each bundle to the one before it.
-using v2d = double __attribute__((vector_size(16)));
-FLOEDEM_LANES v4d lanes(double a, double b, double c, double d) {
-  const v2d low{a, b}, high{c, d};
-  return __builtin_shufflevector(low, high, 0, 1, 2, 3);
-}
 FLOEDEM_LANES Side gather(const std::int32_t* body, const Vec2* v, const double* w) {
   static_assert(kBundleLanes == 4);
   return {lanes(v[body[0]].x, v[body[1]].x, v[body[2]].x, v[body[3]].x),
@@ -232,14 +224,11 @@ SweepResult sweep_baseline(std::span<SweepBundle> bundles, Vec2* v, double* w, d
 }
 #endif
 
-// The build in use; set once from the processor, or by use_sweep_isa.
-std::atomic<SweepIsa> sweep_isa{available_sweep_isas().back()};
-
 SweepResult sweep_once(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
-  switch (sweep_isa.load(std::memory_order_relaxed)) {
+  switch (lane_isa()) {
 #ifdef FLOEDEM_HAS_AVX2_SWEEP
-    case SweepIsa::avx512: return sweep_avx512(bundles, v, w, change);
-    case SweepIsa::avx2: return sweep_avx2(bundles, v, w, change);
+    case LaneIsa::avx512: return sweep_avx512(bundles, v, w, change);
+    case LaneIsa::avx2: return sweep_avx2(bundles, v, w, change);
 #endif
     default: return sweep_baseline(bundles, v, w, change);
   }
@@ -540,22 +529,6 @@ std::size_t colour_manifolds(std::span<Manifold> manifolds, std::span<const std:
   return bundles_of(colour(Selection{manifolds, island}, bodies, colours, body_colours));
 }
 
-std::vector<SweepIsa> available_sweep_isas() {
-#ifdef FLOEDEM_HAS_AVX2_SWEEP
-  return available_lane_isas();
-#else
-  return {SweepIsa::baseline};
-#endif
-}
-
-void use_sweep_isa(SweepIsa isa) {
-  const std::vector<SweepIsa> isas = available_sweep_isas();
-  if (std::find(isas.begin(), isas.end(), isa) == isas.end())
-    throw std::invalid_argument("use_sweep_isa: this processor does not run that build of the sweep");
-  sweep_isa.store(isa);
-}
-
-void use_fastest_sweep_isa() { sweep_isa.store(available_sweep_isas().back()); }
 
 int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& s,
                    const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate,

@@ -31,7 +31,6 @@
 #include <span>
 #include <vector>
 
-#include "geometry/lane_isa.hpp"
 #include "solver/contact_solver.hpp"
 
 namespace floedem {
@@ -54,15 +53,6 @@ std::size_t colour_manifolds(std::span<Manifold> manifolds, std::span<const std:
                              const BodyArrays& bodies, std::span<std::int32_t> colours,
                              std::span<std::uint64_t> body_colours);
 
-/// The builds of the sweep (the same impulses to the bit): the x86-64 baseline (SSE2), AVX2,
-/// and AVX2 with AVX-512's 32 registers (geometry/lane_isa.hpp). The fastest the processor has
-/// runs unless a test or a benchmark asks for another.
-using SweepIsa = LaneIsa;
-/// Those this processor runs, slowest first.
-std::vector<SweepIsa> available_sweep_isas();
-/// The build every coloured sweep uses from now on (one this processor runs).
-void use_sweep_isa(SweepIsa isa);
-/// Back to the fastest.
-void use_fastest_sweep_isa();
+// The sweep is built for each LaneIsa (geometry/lane_isa.hpp): the same impulses to the bit.
 
 }  // namespace floedem

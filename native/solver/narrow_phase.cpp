@@ -4,6 +4,8 @@
 #include <limits>
 #include <type_traits>
 
+#include "geometry/lane_isa.hpp"
+
 namespace floedem {
 
 namespace {
@@ -84,7 +86,7 @@ void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip,
 
 // collide() into either manifold type: the same arithmetic, the same fields.
 template <class M>
-void collide_into(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, M& m,
+[[gnu::always_inline]] inline void collide_into(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, M& m,
                   SeparationHint* hint) {
   m.point_count = 0;
   // The last test's best edges first (a pair's two floes turn little in a step): where either
@@ -173,16 +175,51 @@ void collide_into(const PartGeometry& a, const PartGeometry& b, double margin, d
   }
 }
 
+// collide_into built for each LaneIsa (geometry/lane_isa.hpp): the same SSE2 lanes and scalar
+// operations, VEX-encoded with three operands in the AVX builds and with AVX-512's 32 registers
+// in the last, so the same manifold to the bit.
+template <class M>
+void collide_baseline(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, M& m,
+                      SeparationHint* hint) {
+  collide_into(a, b, margin, flip_tolerance, m, hint);
+}
+#if defined(__x86_64__)
+#define FLOEDEM_HAS_AVX_NARROW 1
+template <class M>
+[[gnu::target("avx2")]] void collide_avx2(const PartGeometry& a, const PartGeometry& b, double margin,
+                                          double flip_tolerance, M& m, SeparationHint* hint) {
+  collide_into(a, b, margin, flip_tolerance, m, hint);
+}
+template <class M>
+[[gnu::target("avx2,avx512f,avx512vl")]] void collide_avx512(const PartGeometry& a, const PartGeometry& b,
+                                                             double margin, double flip_tolerance, M& m,
+                                                             SeparationHint* hint) {
+  collide_into(a, b, margin, flip_tolerance, m, hint);
+}
+#endif
+
+template <class M>
+void collide_any(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, M& m,
+                 SeparationHint* hint) {
+  switch (lane_isa()) {
+#ifdef FLOEDEM_HAS_AVX_NARROW
+    case LaneIsa::avx512: return collide_avx512(a, b, margin, flip_tolerance, m, hint);
+    case LaneIsa::avx2: return collide_avx2(a, b, margin, flip_tolerance, m, hint);
+#endif
+    default: return collide_baseline(a, b, margin, flip_tolerance, m, hint);
+  }
+}
+
 }  // namespace
 
 void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, Manifold& m,
              SeparationHint* hint) {
-  collide_into(a, b, margin, flip_tolerance, m, hint);
+  collide_any(a, b, margin, flip_tolerance, m, hint);
 }
 
 void collide(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance,
              NarrowManifold& m, SeparationHint* hint) {
-  collide_into(a, b, margin, flip_tolerance, m, hint);
+  collide_any(a, b, margin, flip_tolerance, m, hint);
 }
 
 }  // namespace floedem

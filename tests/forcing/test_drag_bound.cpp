@@ -9,6 +9,7 @@
 #include <random>
 
 #include "forcing/drag.hpp"
+#include "geometry/lane_isa.hpp"
 #include "geometry/polygon.hpp"
 #include "support.hpp"
 
@@ -203,8 +204,8 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   constexpr std::size_t n = 37;
   int lean_checked = 0;
-  for (const DistributedDrag::Isa isa : DistributedDrag::available_isas()) {
-    DistributedDrag::use_isa(isa);
+  for (const LaneIsa isa : available_lane_isas()) {
+    use_lane_isa(isa);
     for (const bool rotational : {true, false})
       for (const bool still : {false, true})
         for (const auto kind : {DistributedDrag::Kind::form, DistributedDrag::Kind::skin}) {
@@ -271,6 +272,6 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
           }
         }
   }
-  DistributedDrag::use_isa(DistributedDrag::available_isas().back());
+  use_fastest_lane_isa();
   CHECK(lean_checked >= 8 * 2 * 20);  // the lanes took most floes in every case
 }

@@ -13,6 +13,7 @@
 #include "parallel/threads.hpp"
 #include "run/stepper.hpp"
 #include "scenario/scenario.hpp"
+#include "geometry/lane_isa.hpp"
 #include "solver/coloured_sweeps.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/pressed_pack.hpp"
@@ -176,22 +177,22 @@ TEST_CASE("coloured sweeps: a floe with more contacts than colours", "[solver][c
 }
 
 TEST_CASE("coloured sweeps: every build of the sweep gives the same impulses to the bit", "[solver][coloured]") {
-  const std::vector<SweepIsa> isas = available_sweep_isas();
-  REQUIRE(isas.front() == SweepIsa::baseline);
+  const std::vector<LaneIsa> isas = available_lane_isas();
+  REQUIRE(isas.front() == LaneIsa::baseline);
   const bool accelerate = GENERATE(false, true);
   for (const Pack& start : {pack(30, 20, 17, true), star(80)}) {
-    use_sweep_isa(SweepIsa::baseline);
+    use_lane_isa(LaneIsa::baseline);
     const Solved reference = solve(start, {40, 0.0, 20, 1e-6}, true, accelerate);
-    for (const SweepIsa isa : isas) {
+    for (const LaneIsa isa : isas) {
       INFO("build " << static_cast<int>(isa) << (accelerate ? ", NNCG" : ""));
-      use_sweep_isa(isa);
+      use_lane_isa(isa);
       const Solved other = solve(start, {40, 0.0, 20, 1e-6}, true, accelerate);
       CHECK(other.sweeps == reference.sweeps);
       check_same_solve(other.state, reference.state);
     }
   }
-  use_fastest_sweep_isa();
-  CHECK_THROWS(use_sweep_isa(static_cast<SweepIsa>(7)));
+  use_fastest_lane_isa();
+  CHECK_THROWS(use_lane_isa(static_cast<LaneIsa>(7)));
 }
 
 TEST_CASE("coloured sweeps: each colour on the pool's threads, the same impulses to the bit", "[solver][coloured][threads]") {

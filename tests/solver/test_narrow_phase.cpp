@@ -5,6 +5,7 @@
 #include <random>
 
 #include "engine/state_io.hpp"
+#include "geometry/lane_isa.hpp"
 #include "run/stepper.hpp"
 #include "solver/narrow_phase.hpp"
 #include "support.hpp"
@@ -201,7 +202,8 @@ TEST_CASE("narrow phase: a pair's separation hint gives the manifold found witho
   // its last step (SeparationHint). Whatever the hint (none, right, wrong, one that ties the
   // winner), max_face_separation must give the plain search's edge and separation to the bit,
   // and collide() the same manifold. Pairs: random convex polygons (3 to 9 corners) near each
-  // other, and unturned squares on a diagonal, whose edges tie exactly.
+  // other, and unturned squares on a diagonal, whose edges tie exactly. Every build of collide
+  // (geometry/lane_isa.hpp) gives the same manifold.
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   auto polygon = [&](double size) {
@@ -258,6 +260,14 @@ TEST_CASE("narrow phase: a pair's separation hint gives the manifold found witho
     Manifold plain;
     collide(a.geometry(), b.geometry(), margin, 1e-4, plain);
     contacts += plain.point_count > 0;
+    for (const LaneIsa isa : available_lane_isas()) {  // every build of collide, the same to the bit
+      INFO("build " << static_cast<int>(isa));
+      use_lane_isa(isa);
+      Manifold built;
+      collide(a.geometry(), b.geometry(), margin, 1e-4, built);
+      REQUIRE(same_manifold(built, plain));
+    }
+    use_fastest_lane_isa();
     for (int ha = -1; ha < va.count; ++ha)
       for (int hb = -1; hb < vb.count; ++hb) {
         SeparationHint hint{static_cast<std::int16_t>(ha), static_cast<std::int16_t>(hb)};
