@@ -8,6 +8,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "geometry/lane_isa.hpp"
 #include "geometry/lanes4.hpp"
 #include "parallel/thread_pool.hpp"
 

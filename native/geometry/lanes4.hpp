@@ -9,8 +9,6 @@
 #include <cstring>
 #include <limits>
 
-#include "geometry/lane_isa.hpp"
-
 namespace floedem::lanes4 {
 
 using v4d = double __attribute__((vector_size(32)));

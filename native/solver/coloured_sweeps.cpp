@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "geometry/lane_isa.hpp"
 #include "geometry/lanes4.hpp"
 #include "parallel/thread_pool.hpp"
 #include "solver/sweep_row.hpp"

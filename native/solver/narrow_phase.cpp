@@ -86,8 +86,8 @@ void corner_contact(const PartGeometry& ref, const PartGeometry& inc, bool flip,
 
 // collide() into either manifold type: the same arithmetic, the same fields.
 template <class M>
-[[gnu::always_inline]] inline void collide_into(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, M& m,
-                  SeparationHint* hint) {
+[[gnu::always_inline]] inline void collide_into(const PartGeometry& a, const PartGeometry& b, double margin,
+                                                double flip_tolerance, M& m, SeparationHint* hint) {
   m.point_count = 0;
   // The last test's best edges first (a pair's two floes turn little in a step): where either
   // still separates the pair by more than the margin, the pair is apart (the largest separation
