@@ -441,34 +441,30 @@ FLOEDEM_LANES void skin_quad(LaneIo& io, const Group& g, const Slot* slot) {
   store(io.q2, q2);
 }
 
-template <class Group, class Slot>
-void form_baseline(LaneIo& io, const Group& g, const Slot* slot, bool rotational) {
-  rotational ? form_quad<true>(io, g, slot) : form_quad<false>(io, g, slot);
+// One group's sums: form or skin drag, with or without the torque (the term's settings).
+template <class Group, class FormSlot, class SkinSlot>
+FLOEDEM_LANES void quad(LaneIo& io, const Group& g, const FormSlot* form, const SkinSlot* skin, bool rotational) {
+  if (form != nullptr)
+    rotational ? form_quad<true>(io, g, form) : form_quad<false>(io, g, form);
+  else
+    rotational ? skin_quad<true>(io, g, skin) : skin_quad<false>(io, g, skin);
 }
-template <class Group, class Slot>
-void skin_baseline(LaneIo& io, const Group& g, const Slot* slot, bool rotational) {
-  rotational ? skin_quad<true>(io, g, slot) : skin_quad<false>(io, g, slot);
+template <class Group, class FormSlot, class SkinSlot>
+void quad_baseline(LaneIo& io, const Group& g, const FormSlot* form, const SkinSlot* skin, bool rotational) {
+  quad(io, g, form, skin, rotational);
 }
 #if defined(__x86_64__)
 #define FLOEDEM_HAS_AVX2_DRAG 1
-template <class Group, class Slot>
-[[gnu::target("avx2")]] void form_avx2(LaneIo& io, const Group& g, const Slot* slot, bool rotational) {
-  rotational ? form_quad<true>(io, g, slot) : form_quad<false>(io, g, slot);
-}
-template <class Group, class Slot>
-[[gnu::target("avx2")]] void skin_avx2(LaneIo& io, const Group& g, const Slot* slot, bool rotational) {
-  rotational ? skin_quad<true>(io, g, slot) : skin_quad<false>(io, g, slot);
+template <class Group, class FormSlot, class SkinSlot>
+[[gnu::target("avx2")]] void quad_avx2(LaneIo& io, const Group& g, const FormSlot* form, const SkinSlot* skin,
+                                       bool rotational) {
+  quad(io, g, form, skin, rotational);
 }
 // AVX-512's 32 vector registers (for the same 4-lane vectors) spare the AVX2 build's spills.
-template <class Group, class Slot>
-[[gnu::target("avx2,avx512f,avx512vl")]] void form_avx512(LaneIo& io, const Group& g, const Slot* slot,
-                                                          bool rotational) {
-  rotational ? form_quad<true>(io, g, slot) : form_quad<false>(io, g, slot);
-}
-template <class Group, class Slot>
-[[gnu::target("avx2,avx512f,avx512vl")]] void skin_avx512(LaneIo& io, const Group& g, const Slot* slot,
-                                                          bool rotational) {
-  rotational ? skin_quad<true>(io, g, slot) : skin_quad<false>(io, g, slot);
+template <class Group, class FormSlot, class SkinSlot>
+[[gnu::target("avx2,avx512f,avx512vl")]] void quad_avx512(LaneIo& io, const Group& g, const FormSlot* form,
+                                                          const SkinSlot* skin, bool rotational) {
+  quad(io, g, form, skin, rotational);
 }
 #endif
 }  // namespace
@@ -542,14 +538,10 @@ void DistributedDrag::add_group(const LaneGroup& g, unsigned mask, const BodySta
   const SkinSlot* skin = kind_ == Kind::skin ? skin_lanes_.data() + g.first : nullptr;
   switch (lane_isa()) {
 #ifdef FLOEDEM_HAS_AVX2_DRAG
-    case LaneIsa::avx512:
-      kind_ == Kind::form ? form_avx512(io, g, form, rotational) : skin_avx512(io, g, skin, rotational);
-      break;
-    case LaneIsa::avx2:
-      kind_ == Kind::form ? form_avx2(io, g, form, rotational) : skin_avx2(io, g, skin, rotational);
-      break;
+    case LaneIsa::avx512: quad_avx512(io, g, form, skin, rotational); break;
+    case LaneIsa::avx2: quad_avx2(io, g, form, skin, rotational); break;
 #endif
-    default: kind_ == Kind::form ? form_baseline(io, g, form, rotational) : skin_baseline(io, g, skin, rotational);
+    default: quad_baseline(io, g, form, skin, rotational);
   }
   for (int l = 0; l < kLanes; ++l)
     if (mask & (1u << l)) sums.q[io.body[l]] = {io.q0[l], io.q1[l], io.q2[l]};
