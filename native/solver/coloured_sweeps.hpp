@@ -40,10 +40,12 @@ namespace floedem {
 /// the manifolds, the scene's body_colours (all zero, and left so) and, with `accelerate`,
 /// bundle_change/direction/step (SweepWork::reserve with colour_bodies).
 /// With `threads`, each colour's bundles are swept on the pool's threads (not from inside a
-/// loop of the pool): the same impulses to the bit as without.
+/// loop of the pool): the same impulses to the bit as without. Without `accelerate`, each
+/// colour's manifolds of two points take its first bundles unless `given_order` (the same
+/// impulses to the bit, in fewer bundle-points: coloured_sweeps.cpp).
 int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& bodies,
                    const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate,
-                   bool threads = false);
+                   bool threads = false, bool given_order = false);
 
 /// The colours solve_coloured gives the manifolds `island` (its first pass, made apart): each
 /// manifold's colour into colours[i], body_colours all zero again on return. Returns the

@@ -293,7 +293,8 @@ SweepSpace SweepWork::slice(std::size_t first, std::size_t count, std::size_t bu
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepSpace space,
                      SweepOptions options) {
   if (options.colour)
-    return solve_coloured(manifolds, {}, s, limits, space, options.warm_start, options.accelerate, options.pipeline);
+    return solve_coloured(manifolds, {}, s, limits, space, options.warm_start, options.accelerate, options.pipeline,
+                          options.given_order);
   return solve_rows(AllRows{manifolds}, s, limits, space, options);
 }
 
@@ -301,7 +302,7 @@ int solve_velocities(std::span<Manifold> manifolds, std::span<const std::int32_t
                      const SweepLimits& limits, SweepSpace space, SweepOptions options) {
   if (options.colour)
     return solve_coloured(manifolds, island, s, limits, space, options.warm_start, options.accelerate,
-                          options.pipeline);
+                          options.pipeline, options.given_order);
   return solve_rows(IslandRows{manifolds, island}, s, limits, space, options);
 }
 

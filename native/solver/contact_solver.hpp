@@ -141,6 +141,10 @@ struct SweepOptions {
   /// sweeps. Needs the space's coloured arrays. With `pipeline` (which it does not use), each
   /// colour is swept on the pool's threads, with `accelerate` too: the same to the bit.
   bool colour = false;
+  /// Coloured, without `accelerate`: place each colour's manifolds in the order given, not
+  /// those of two points first (coloured_sweeps.cpp: the same impulses to the bit; the tests
+  /// compare the two).
+  bool given_order = false;
 };
 /// `space` must hold manifolds.size() manifolds (and their accelerated arrays with `accelerate`).
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& bodies, const SweepLimits& limits, SweepSpace space,
