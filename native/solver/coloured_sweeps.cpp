@@ -427,7 +427,11 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
       p.tangent_impulse[lane] = q.tangent_impulse;
       warm(q);
     }
-    if (c.point_count == 1) empty_point(b.point[1], lane);
+    // A one-point lane's second point is swept only in a bundle with a two-point lane: placed
+    // two-point first, a bundle past the colour's two-point manifolds sweeps point 0 alone,
+    // and its second point is left as it was (16 doubles a lane, not written or read).
+    if (c.point_count == 1 && n - n % kBundleLanes < (two_points_first ? two[colour] : count[colour]))
+      empty_point(b.point[1], lane);
     if (lane == kBundleLanes - 1 && bundle != meeting[colour]) reciprocals(b);  // full
   }
   for (int c = 0; c < kColours; ++c) {  // the lanes left in each colour's last bundle
