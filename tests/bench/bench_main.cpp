@@ -99,12 +99,14 @@ BENCHMARK(BM_StepCoriolisOnly)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond)
 BENCHMARK(BM_StepFullEnvironment)->Arg(1)->Arg(1000)->Unit(benchmark::kMicrosecond);
 
 /// Drag quadrature (a third of a step in a drifting field): N floes, 5 to 9 corners, 5 to 30 m,
-/// drifting and turning in a current, water form and skin drag. Arg(1): the terms' packed
-/// quadrature (drag.cpp); Arg(0): the point-by-point rule it reproduces to the bit, over point
-/// lists made once per floe (as the terms held them before they were packed).
+/// drifting and turning in a current, water form and skin drag. First argument 1: the terms'
+/// packed quadrature (drag.cpp); 0: the point-by-point rule it reproduces to the bit, over point
+/// lists made once per floe (as the terms held them before they were packed). Second: N, 1 000
+/// (the points in L2) or 16 000 (the speed benchmark's field: about 20 MB of points, streamed
+/// from L3 or memory each step, as in the field's step).
 void BM_DragQuadrature(benchmark::State& state) {
   const bool packed = state.range(0) != 0;
-  const int n = 1000;
+  const auto n = static_cast<int>(state.range(1));
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   EnvironmentSpec env;
@@ -158,7 +160,7 @@ void BM_DragQuadrature(benchmark::State& state) {
   state.counters["ns_per_floe"] =
       benchmark::Counter(n, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_DragQuadrature)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DragQuadrature)->Args({0, 1000})->Args({1, 1000})->Args({1, 16000})->Unit(benchmark::kMicrosecond);
 
 /// Field generation (issue 4's targets: 1e4 floes under 2 s, 1e5 under 20 s on 2 cores):
 /// alpha 2, d 2..50 m, C 0.5, default irregularity; the square domain holds N floes.
