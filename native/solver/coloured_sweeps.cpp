@@ -268,21 +268,19 @@ void empty_lane(SweepBundle& b, int l) {
   for (BundlePoint& p : b.point) empty_point(p, l);
 }
 
-// The local solve's divisors of a full bundle's points as reciprocals, four lanes at a time
-// (an empty lane's are 1; a slide's divisor that is not positive gives NaN: never holds).
-void reciprocals(SweepBundle& b) {
-  const v4d mu = load(b.friction), zero = splat(0.0), one = splat(1.0);
-  const v4d nan = splat(std::numeric_limits<double>::quiet_NaN());
-  for (int k = 0; k < b.points; ++k) {
-    BundlePoint& p = b.point[k];
-    const v4d wnn = load(p.wnn), wnt = load(p.wnt), wtt = load(p.wtt);
-    store(p.inv_det, one / (wnn * wtt - wnt * wnt));
-    store(p.inv_wnn, one / wnn);
-    store(p.inv_wtt, one / wtt);
-    const v4d plus = wnn - mu * wnt, minus = wnn + mu * wnt;
-    store(p.inv_slide_plus, select((v4m)(plus > zero), one / plus, nan));
-    store(p.inv_slide_minus, select((v4m)(minus > zero), one / minus, nan));
-  }
+// The local solve's divisors of one lane's point as reciprocals (a slide's divisor that is not
+// positive gives NaN: never holds), from the values just stored into it, as each lane is
+// packed: a 16-byte load of two lanes that separate 8-byte stores had just written could not
+// be forwarded from them and waited for both to retire (perf: the packing's hottest loads,
+// when the reciprocals were made four lanes at a time once a bundle was full). Each division
+// rounds the same alone as in a lane.
+void lane_reciprocals(BundlePoint& p, int l, double wnn, double wnt, double wtt, double mu) {
+  p.inv_det[l] = 1.0 / (wnn * wtt - wnt * wnt);
+  p.inv_wnn[l] = 1.0 / wnn;
+  p.inv_wtt[l] = 1.0 / wtt;
+  const double plus = wnn - mu * wnt, minus = wnn + mu * wnt;
+  p.inv_slide_plus[l] = plus > 0.0 ? 1.0 / plus : std::numeric_limits<double>::quiet_NaN();
+  p.inv_slide_minus[l] = minus > 0.0 ? 1.0 / minus : std::numeric_limits<double>::quiet_NaN();
 }
 
 // Manifold i of the solve (all of them, or the island's).
@@ -363,14 +361,12 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
   }
   if (!two_points_first) two.fill(0);
   // Each colour's first bundle, and where its next manifold of two points and of one go (every
-  // manifold in the second list without two_points_first); the bundle where the two lists
-  // meet, filled out of lane order (none: SIZE_MAX), gets its reciprocals after the loop.
-  std::array<std::size_t, kColours> first{}, next_two{}, next_one{}, meeting{};
+  // manifold in the second list without two_points_first).
+  std::array<std::size_t, kColours> first{}, next_two{}, next_one{};
   Gathered g;
   for (int c = 0; c < kColours; ++c) {
     first[c] = g.colour_start[c] = g.bundles;
     next_one[c] = two[c];
-    meeting[c] = two[c] % kBundleLanes != 0 ? first[c] + two[c] / kBundleLanes : SIZE_MAX;
     g.bundles += (count[static_cast<std::size_t>(c)] + kBundleLanes - 1) / kBundleLanes;
   }
   g.colour_start[kColours] = g.bundles;
@@ -394,8 +390,7 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
       continue;
     }
     const std::size_t n = two_points_first && c.point_count == 2 ? next_two[colour]++ : next_one[colour]++;
-    const std::size_t bundle = first[colour] + n / kBundleLanes;
-    SweepBundle& b = space.bundles[bundle];
+    SweepBundle& b = space.bundles[first[colour] + n / kBundleLanes];
     const auto lane = static_cast<int>(n % kBundleLanes);
     // Every field of a lane is written below (or by empty_lane). Where the lists meet, lane 0
     // (of two points) may come after a later lane (of one): set to 0 then, the bundle's
@@ -422,6 +417,7 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
       p.wnn[lane] = q.wnn;
       p.wnt[lane] = q.wnt;
       p.wtt[lane] = q.wtt;
+      lane_reciprocals(p, lane, q.wnn, q.wnt, q.wtt, c.friction);
       p.target[lane] = q.target_velocity;
       p.normal_impulse[lane] = q.normal_impulse;
       p.tangent_impulse[lane] = q.tangent_impulse;
@@ -432,17 +428,12 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
     // and its second point is left as it was (16 doubles a lane, not written or read).
     if (c.point_count == 1 && n - n % kBundleLanes < (two_points_first ? two[colour] : count[colour]))
       empty_point(b.point[1], lane);
-    if (lane == kBundleLanes - 1 && bundle != meeting[colour]) reciprocals(b);  // full
   }
   for (int c = 0; c < kColours; ++c) {  // the lanes left in each colour's last bundle
     const std::size_t n = count[static_cast<std::size_t>(c)];
-    const std::size_t last = first[c] + n / kBundleLanes;
-    if (n % kBundleLanes != 0) {
-      SweepBundle& b = space.bundles[last];
-      for (auto l = static_cast<int>(n % kBundleLanes); l < kBundleLanes; ++l) empty_lane(b, l);
-      reciprocals(b);
-    }
-    if (meeting[c] != SIZE_MAX && meeting[c] != last) reciprocals(space.bundles[meeting[c]]);
+    if (n % kBundleLanes == 0) continue;
+    SweepBundle& b = space.bundles[first[c] + n / kBundleLanes];
+    for (auto l = static_cast<int>(n % kBundleLanes); l < kBundleLanes; ++l) empty_lane(b, l);
   }
   return g;
 }
