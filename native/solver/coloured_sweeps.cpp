@@ -294,6 +294,12 @@ struct Selection {
 };
 
 constexpr int kColours = 63;  // colours 0..62 in the masks' bits; a manifold that finds none is swept as a row
+// A manifold's colour as colour() writes it: the colour, plus this flag where it has two
+// points, so that a solve given the colours counts each colour's two-point manifolds from the
+// colours alone (reading each 384-byte manifold again for its point count was another pass
+// over them, out of cache at 16k floes).
+constexpr std::int32_t kTwoPoints = 128;
+constexpr std::int32_t colour_of(std::int32_t written) { return written & (kTwoPoints - 1); }
 
 // Colours the manifolds, packs them into bundles colour by colour (each colour's manifolds in
 // the given order) and those beyond the colours into rows (space.rows, their manifolds listed
@@ -303,9 +309,9 @@ struct Gathered {
   std::size_t bundles = 0, rows = 0, overflow = 0;
   std::array<std::size_t, kColours + 1> colour_start{};  // each colour's first bundle
 };
-// Each manifold's colour into colours[i] (kColours: none left); the counts per colour, and
-// with `two` those of two points. body_colours is all zero again on return (a fixed body's
-// entry, shared across threads, is never written).
+// Each manifold's colour into colours[i] (kColours: none left; kTwoPoints added where it has
+// two points); the counts per colour, and with `two` those of two points. body_colours is all
+// zero again on return (a fixed body's entry, shared across threads, is never written).
 std::array<std::size_t, kColours + 1> colour(const Selection& m, const BodyArrays& s, std::span<std::int32_t> colours,
                                              std::span<std::uint64_t> taken,
                                              std::array<std::size_t, kColours + 1>* two = nullptr) {
@@ -322,7 +328,7 @@ std::array<std::size_t, kColours + 1> colour(const Selection& m, const BodyArray
       if (ma) taken[c.body_a] |= bit;
       if (mb) taken[c.body_b] |= bit;
     }
-    colours[i] = k;
+    colours[i] = k + (c.point_count == 2 ? kTwoPoints : 0);
     ++count[static_cast<std::size_t>(k)];
     if (two != nullptr) (*two)[static_cast<std::size_t>(k)] += c.point_count == 2;
   }
@@ -352,9 +358,9 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
   std::array<std::size_t, kColours + 1> count{}, two{};
   if (space.colours_given) {
     for (std::size_t i = 0; i < m.size(); ++i) {
-      const auto c = static_cast<std::size_t>(space.overflow[i]);
+      const auto c = static_cast<std::size_t>(colour_of(space.overflow[i]));
       ++count[c];
-      two[c] += m[i].point_count == 2;
+      two[c] += (space.overflow[i] & kTwoPoints) != 0;
     }
   } else {
     count = colour(m, s, space.overflow, space.body_colours, &two);
@@ -378,7 +384,7 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
       if (warm_start && (q.normal_impulse != 0.0 || q.tangent_impulse != 0.0))
         apply_impulse(s, c, q, 1.0 * (q.normal_impulse * c.normal + q.tangent_impulse * t));
     };
-    const auto colour = static_cast<std::size_t>(space.overflow[i]);
+    const auto colour = static_cast<std::size_t>(colour_of(space.overflow[i]));
     if (colour == kColours) {  // no colour left: rows, swept after the bundles
       space.overflow[g.overflow++] = static_cast<std::int32_t>(i);  // i >= g.overflow: read already
       for (int k = 0; k < c.point_count; ++k) {

@@ -48,7 +48,8 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
                    bool threads = false, bool given_order = false);
 
 /// The colours solve_coloured gives the manifolds `island` (its first pass, made apart): each
-/// manifold's colour into colours[i], body_colours all zero again on return. Returns the
+/// manifold's colour into colours[i] (with a flag for a manifold of two points: values for
+/// solve_coloured to read), body_colours all zero again on return. Returns the
 /// bundles they take, so that a caller can give each island's solve the room it needs, and the
 /// solve the colours (SweepSpace::colours_given).
 std::size_t colour_manifolds(std::span<Manifold> manifolds, std::span<const std::int32_t> island,
