@@ -115,6 +115,10 @@ class Engine {
   virtual const BodyStates& state() const = 0;
   /// The contact impulses of the last step.
   virtual std::span<const ContactRecord> contacts() const = 0;
+  /// Each body's Rot::from_angle(state().angle[i]), where the engine keeps them (the native
+  /// engine turns its parts with them), else empty: the forcing then makes its own. Read by
+  /// the forcing in place of a sine and cosine per body and step.
+  virtual std::span<const Rot> rotations() const { return {}; }
   virtual EngineInfo info() const = 0;
 
   /// Checkpoint and restart (floedem run --resume): writes everything the engine's next steps

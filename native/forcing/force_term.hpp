@@ -134,7 +134,9 @@ class Forcing {
   /// Whether its steps after the first work on the moving bodies alone (see moving_only_).
   bool works_on_moving_bodies_only() const { return moving_only_; }
   /// Loads for the step that starts at `time`, or nullptr when the scene has no forcing.
-  const Loads* evaluate(const BodyStates& state, double time);
+  /// `rotations`: each body's Rot::from_angle(angle), where the engine has them (Engine::
+  /// rotations); empty, the forcing makes them.
+  const Loads* evaluate(const BodyStates& state, double time, std::span<const Rot> rotations = {});
   /// The generalised force of all terms on prescribed (towed) body i over the last evaluated
   /// step, Coriolis included (-m f k x v at its prescribed velocity). Towing reads it.
   std::array<double, 3> environment_force(std::size_t i) const;
@@ -154,7 +156,8 @@ class Forcing {
   /// engine's positions and angles.
   std::vector<Vec2> moved_velocity_;
   std::vector<double> moved_angular_velocity_;
-  std::vector<double> rotated_angle_;  ///< the angle sums_.rotation[i] was computed for
+  std::vector<double> rotated_angle_;  ///< the angle sums_.rotation[i] was computed for (NaN: none)
+  bool rotations_copied_ = false;      ///< the last evaluate copied the engine's rotations
   std::vector<double> cached_rate_, cached_tan_, cached_half_tan_;  ///< Coriolis turn per body
   struct BodyHot {
     bool moves = false;  ///< neither fixed nor prescribed

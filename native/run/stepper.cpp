@@ -10,7 +10,7 @@ Stepper::Stepper(const Scene& scene, const std::string& engine)
 void Stepper::step() {
   const double start = time();
   if (tow_.active()) stages_.time(kTowing, [&] { tow_.before_step(engine_->state(), start); });
-  stages_.time(kForcing, [&] { loads_ = forcing_.evaluate(engine_->state(), start); });
+  stages_.time(kForcing, [&] { loads_ = forcing_.evaluate(engine_->state(), start, engine_->rotations()); });
   engine_->step(loads_);
   if (tow_.active())
     stages_.time(kTowing, [&] { tow_.after_step(engine_->contacts(), forcing_.environment_force(scene_.tow.body)); });

@@ -44,6 +44,7 @@ class NativeEngine final : public Engine {
   explicit NativeEngine(const Scene& scene);
   void step(const Loads* loads) override;
   const BodyStates& state() const override { return bodies_; }
+  std::span<const Rot> rotations() const override { return bodies_.rotation; }
   std::span<const ContactRecord> contacts() const override { return records_; }
   EngineInfo info() const override;
   void time_stages(bool on) override { stages_.enable(on); }

@@ -193,6 +193,38 @@ TEST_CASE("forcing: in still water with Coriolis the moving bodies alone give ev
   }
 }
 
+TEST_CASE("forcing: the native engine's rotations give the loads of the angles to the bit", "[forcing]") {
+  // The forcing copies the engine's Rot::from_angle(angle) per body (Engine::rotations) instead
+  // of making its own: the same loads to the bit, step after step, as a forcing that makes them
+  // from the angles, and again when it falls back to the angles midway (it must not keep the
+  // rotations of a step it did not make them for). Six floes spun by their drag in a current
+  // and a wind across it, colliding; rotational drag on.
+  std::string t = "[run]\nduration = 20.0\ndt = 0.1\n[environment]\ncurrent = [0.4, 0.1]\nwind = [-3.0, 6.0]\n";
+  for (int i = 0; i < 6; ++i)
+    t += test::body_toml({"f" + std::to_string(i), test::box({14.0 * i, 3.0 * (i % 2)}, 10.0 + i, 6.0, 0.3 * i),
+                          {0.2 * (i % 3), 0.0}, 0.02 * (i - 3)});
+  const Scene s = test::scene_from(t);
+  auto engine = test::native(s);
+  REQUIRE(engine->rotations().size() == s.bodies.size());
+  Forcing from_engine(s), from_angles(s);
+  double turned = 0.0;
+  for (int k = 0; k < 200; ++k) {
+    INFO("step " << k);
+    const double time = 0.1 * k;
+    // Steps 80 to 89: the first forcing makes its own rotations too (and then takes the engine's again).
+    const Loads* a = from_engine.evaluate(engine->state(), time, k / 10 == 8 ? std::span<const Rot>{} : engine->rotations());
+    const Loads* b = from_angles.evaluate(engine->state(), time);
+    for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+      CHECK(std::bit_cast<std::uint64_t>(a->force[i].x) == std::bit_cast<std::uint64_t>(b->force[i].x));
+      CHECK(std::bit_cast<std::uint64_t>(a->force[i].y) == std::bit_cast<std::uint64_t>(b->force[i].y));
+      CHECK(std::bit_cast<std::uint64_t>(a->torque[i]) == std::bit_cast<std::uint64_t>(b->torque[i]));
+    }
+    engine->step(a);
+  }
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) turned += std::abs(engine->state().angle[i]);
+  CHECK(turned > 0.5);  // rad, summed: the floes turned, so the rotations were not all the identity
+}
+
 TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit, in every build",
           "[forcing]") {
   // 37 floes (nine groups of four and one lane more), 3 to 9 corners, some with a zero-length
