@@ -491,8 +491,16 @@ void DistributedDrag::pack_lanes() const {
   skin_lanes_.clear();
   in_lanes_.assign(entries_.size(), 0);
   laned_.assign(entries_.size(), 0);
+  unlaned_.clear();
   lanes_packed_ = true;
-  if (settings_.reference_speed > 0.0) return;  // linearised drag never takes the lean path
+  auto list_unlaned = [&] {
+    for (std::size_t i = 0; i < entries_.size(); ++i)
+      if (laned_[i] == 0) unlaned_.push_back(static_cast<std::uint32_t>(i));
+  };
+  if (settings_.reference_speed > 0.0) {  // linearised drag never takes the lean path
+    list_unlaned();
+    return;
+  }
   // The entries of one slab (floes), in windows of 64 in entry order (bodies near in memory),
   // each window sorted by its entries' points so that a group's lanes end about together.
   std::vector<std::uint32_t> single;
@@ -516,6 +524,7 @@ void DistributedDrag::pack_lanes() const {
     for (std::uint32_t l = 0; l < kLanes; ++l) {
       const std::uint32_t i = single[k + (l < g.lanes ? l : 0)];
       g.entry[l] = i;
+      g.body[l] = static_cast<std::uint32_t>(entries_[i].body);
       if (l >= g.lanes) continue;  // read as lane 0, never stored
       laned_[i] = 1;
       const Slab& slab = slabs_[entries_[i].first_slab];
@@ -543,11 +552,12 @@ void DistributedDrag::pack_lanes() const {
     }
     groups_.push_back(g);
   }
+  list_unlaned();
 }
 
 void DistributedDrag::add_group(const LaneGroup& g, unsigned mask, const BodyStatesView& s, ForceSums& sums) const {
   LaneIo io{s.velocity.data(), s.angular_velocity.data(), sums.rotation.data(), sums.q.data(), {}, {}, {}, {}};
-  for (int l = 0; l < kLanes; ++l) io.body[l] = quiet_[g.entry[l]].body;
+  for (int l = 0; l < kLanes; ++l) io.body[l] = g.body[l];
   const bool rotational = settings_.rotational;
   // The group's slots: in form_lanes_ for form drag, in skin_lanes_ for skin drag (the other empty).
   const FormSlot* form = kind_ == Kind::form ? form_lanes_.data() + g.first : nullptr;
@@ -582,8 +592,44 @@ void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& 
 }
 
 bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) const {
-  for_entries(sums, 2048, [&](std::size_t i) { add_entry_bound(i, s, sums); });
+  if (!lanes_packed_) pack_lanes();
+  if (!lanes_direct()) {
+    for_entries(sums, 2048, [&](std::size_t i) { add_entry_bound(i, s, sums); });
+    return true;
+  }
+  // A moving flow: the lanes' floes from their groups (each body's one slab, read from the
+  // group: the body, its flow and moments, in place of the entry's records), the rest entry
+  // by entry. Each body is written by one of the two loops, with add_entry_bound's arithmetic.
+  thread_pool().for_blocks(unlaned_.size(), 2048, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) add_entry_bound(unlaned_[k], s, sums);
+  });
+  thread_pool().for_blocks(groups_.size(), 512, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const LaneGroup& g = groups_[k];
+      for (std::uint32_t l = 0; l < g.lanes; ++l) {
+        const std::uint32_t body = g.body[l];
+        const Vec2 v = s.velocity[body], flow{g.flow_x[l], g.flow_y[l]};
+        const double w = s.angular_velocity[body];
+        if (w == 0.0 && flow.x == v.x && flow.y == v.y) continue;  // adds_nothing
+        add_slab_bound(sums.rate_bound[body], quiet_[g.entry[l]].moments, flow, v, w);
+      }
+    }
+  });
   return true;
+}
+
+void DistributedDrag::add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& m, Vec2 flow, Vec2 v,
+                                     double w) const {
+  constexpr double kRow = 1.0 + 1.4142135623730951;  // add_entry_bound says why
+  if (settings_.reference_speed > 0.0) {
+    b[0] += settings_.reference_speed * m[0];
+    b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
+    return;
+  }
+  const double du = length(flow - v);
+  const double spin = settings_.rotational ? std::abs(w) : 0.0;
+  b[0] += kRow * (du * m[0] + spin * m[1]);
+  b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
 }
 
 void DistributedDrag::add_entry_bound(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {
@@ -593,32 +639,20 @@ void DistributedDrag::add_entry_bound(std::size_t i, const BodyStatesView& s, Fo
   //   linearised (m -> U_ref):          |k| U_ref and |k| U_ref |r|^2
   // where g = k x r maps the spin to the point's velocity, so summing over the points bounds
   // the row sums of D's translational block and |D_ww| (forcing.cpp's stiffness test).
-  constexpr double kRow = 1.0 + 1.4142135623730951;
   const std::size_t body = quiet_[i].body;
   const Vec2 v = s.velocity[body];
-  if (adds_nothing(i, v, s.angular_velocity[body])) return;  // adds nothing to D either
-  const double w = std::abs(s.angular_velocity[body]);
+  const double w = s.angular_velocity[body];
+  if (adds_nothing(i, v, w)) return;  // adds nothing to D either
   std::array<double, 2>& b = sums.rate_bound[body];
-  auto add_slab = [&](const std::array<double, 4>& m, Vec2 flow) {
-    if (settings_.reference_speed > 0.0) {
-      b[0] += settings_.reference_speed * m[0];
-      b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
-      return;
-    }
-    const double du = length(flow - v);
-    const double spin = settings_.rotational ? w : 0.0;
-    b[0] += kRow * (du * m[0] + spin * m[1]);
-    b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
-  };
   const Quiet& q = quiet_[i];
   if (q.single) {  // one slab (a floe): all from the packed record, no trip to the entry
-    add_slab(q.moments, q.flow);
+    add_slab_bound(b, q.moments, q.flow, v, w);
     return;
   }
   const Entry& e = entries_[i];
   for (std::uint32_t k = 0; k < e.slab_count; ++k) {
     const Slab& slab = slabs_[e.first_slab + k];
-    add_slab(slab.moments, slab.drag.flow);
+    add_slab_bound(b, slab.moments, slab.drag.flow, v, w);
   }
 }
 
@@ -644,25 +678,48 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
   // each in the same order as one thread would, so the sums do not depend on the threads.
   // The floes that take the lean path are left to the lanes (add_entry marks them), which then
   // add them four at a time: each body's sums are written once, by one of the two loops.
+  // A moving flow (lanes_direct): add_entry visits the entries without a lane alone, and each
+  // group finds its own lanes to add, as add_entry would mark them (the floe adds something
+  // and needs no Jacobian).
   if (!lanes_packed_) pack_lanes();
+  const bool direct = lanes_direct();
   std::atomic<bool> any_jacobian{false};
-  for_entries(sums, 512, [&](std::size_t i) {
+  auto entry = [&](std::size_t i) {
     if (add_entry(i, s, sums) && !any_jacobian.load(std::memory_order_relaxed))
       any_jacobian.store(true, std::memory_order_relaxed);
-  });
-  if (any_jacobian.load(std::memory_order_relaxed)) sums.any_jacobian = true;
+  };
+  if (direct)
+    thread_pool().for_blocks(unlaned_.size(), 512, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) entry(unlaned_[k]);
+    });
+  else
+    for_entries(sums, 512, entry);
   thread_pool().for_blocks(groups_.size(), 128, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const LaneGroup& g = groups_[k];
       unsigned mask = 0;
-      for (std::uint32_t l = 0; l < g.lanes; ++l)
-        if (in_lanes_[g.entry[l]] != 0) {
-          mask |= 1u << l;
-          in_lanes_[g.entry[l]] = 0;
+      for (std::uint32_t l = 0; l < g.lanes; ++l) {
+        const std::uint32_t i = g.entry[l];
+        bool in = false;
+        if (direct) {
+          // add_entry's choice for a floe of one slab and one flow: nothing where it moves with
+          // the flow without spin (adds_nothing), the lanes without the Jacobian, else
+          // add_entry's own path.
+          const std::uint32_t body = g.body[l];
+          const Vec2 v = s.velocity[body];
+          const bool adds = !(s.angular_velocity[body] == 0.0 && g.flow_x[l] == v.x && g.flow_y[l] == v.y);
+          in = adds && sums.jacobian[body] == 0;
+          if (adds && !in) entry(i);
+        } else {
+          in = in_lanes_[i] != 0;
+          in_lanes_[i] = 0;
         }
+        if (in) mask |= 1u << l;
+      }
       if (mask != 0) add_group(g, mask, s, sums);
     }
   });
+  if (any_jacobian.load(std::memory_order_relaxed)) sums.any_jacobian = true;
 }
 
 bool DistributedDrag::add_entry(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {

@@ -105,6 +105,9 @@ class DistributedDrag final : public ForceTerm {
   /// Entry i's force (and Jacobian where its body needs one); returns whether it added a Jacobian.
   bool add_entry(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   void add_entry_bound(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
+  /// One slab's share of the rate bound (add_entry_bound's per-slab sum).
+  void add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& moments, Vec2 flow, Vec2 v,
+                      double w) const;
   /// Calls f(i) for each entry that may add something: every entry, or in still water and air
   /// (calm_) only those of the bodies that move (ForceSums::stirred), in blocks of `grain` on
   /// the pool's threads.
@@ -116,6 +119,7 @@ class DistributedDrag final : public ForceTerm {
   static constexpr int kLanes = 4;
   struct LaneGroup {
     std::array<std::uint32_t, kLanes> entry{};  // lanes past `lanes` repeat lane 0's
+    std::array<std::uint32_t, kLanes> body{};   // each lane's entry's body
     std::array<std::int64_t, kLanes> count{};   // each lane's edges or triangles (0 past `lanes`)
     std::array<double, kLanes> flow_x{}, flow_y{};
     std::array<double, kLanes> start_x{}, start_y{};  // skin: the first half-vertex
@@ -157,6 +161,11 @@ class DistributedDrag final : public ForceTerm {
   mutable std::vector<FormSlot> form_lanes_;
   mutable std::vector<SkinSlot> skin_lanes_;
   mutable std::vector<std::uint8_t> in_lanes_, laned_;  // laned_: the entry has a lane
+  mutable std::vector<std::uint32_t> unlaned_;          // the entries without one, in order
+  /// A moving flow (not calm_): every entry is visited each step, so the lanes' floes are
+  /// taken straight from the groups (rate bound and drag), and add_entry / add_entry_bound
+  /// visit the other entries alone (drag.cpp).
+  bool lanes_direct() const { return !calm_ && lanes_packed_; }
 };
 
 /// The term, or nullptr when no body needs it.

@@ -230,8 +230,9 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
   // 37 floes (nine groups of four and one lane more), 3 to 9 corners, some with a zero-length
   // edge, in one term: most take the four-floe lanes (one slab, no Jacobian, quadratic drag);
   // some need the Jacobian, some have two slabs, and in still water some are at rest and not
-  // visited. Each floe's sums, started from another term's, must be the point-by-point rule's
-  // to the bit, over two steps (the lanes' marks of the first must not leak into the second).
+  // visited; in a moving flow some move with it without spin (nothing to add). Each floe's
+  // sums, started from another term's, must be the point-by-point rule's to the bit, over two
+  // steps (the lanes' marks of the first must not leak into the second).
   std::mt19937_64 rng(29);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   constexpr std::size_t n = 37;
@@ -271,8 +272,9 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
             sums.stirred.clear();
             for (std::size_t i = 0; i < n; ++i) {
               const bool rests = still && (i + static_cast<std::size_t>(step)) % 6 == 2;
-              s.velocity[i] = rests ? Vec2{} : Vec2{0.8 * u(rng), 0.8 * u(rng)};
-              s.angular_velocity[i] = rests ? 0.0 : 0.02 * u(rng);
+              const bool with_flow = !still && (i + static_cast<std::size_t>(step)) % 10 == 3;
+              s.velocity[i] = rests ? Vec2{} : with_flow ? slabs[i].front().flow : Vec2{0.8 * u(rng), 0.8 * u(rng)};
+              s.angular_velocity[i] = rests || with_flow ? 0.0 : 0.02 * u(rng);
               s.angle[i] = M_PI * u(rng);
               sums.rotation[i] = Rot::from_angle(s.angle[i]);
               sums.jacobian[i] = (i + static_cast<std::size_t>(step)) % 8 == 5 ? 1 : 0;
