@@ -398,9 +398,9 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
     const std::size_t n = two_points_first && c.point_count == 2 ? next_two[colour]++ : next_one[colour]++;
     SweepBundle& b = space.bundles[first[colour] + n / kBundleLanes];
     const auto lane = static_cast<int>(n % kBundleLanes);
-    // Every field of a lane is written below (or by empty_lane). Where the lists meet, lane 0
-    // (of two points) may come after a later lane (of one): set to 0 then, the bundle's
-    // count is its own again.
+    // Every field of a lane is written below (or by empty_lane); lane 0 resets the bundle's
+    // point count. Where the two lists meet, lane 0 (two points) may be written after a later
+    // lane (one point): its count, 2, is the bundle's either way.
     if (lane == 0) b.points = 0;
     b.manifold[lane] = static_cast<std::int32_t>(i);
     b.body_a[lane] = c.body_a;
