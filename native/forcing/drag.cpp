@@ -608,10 +608,10 @@ bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) c
       const LaneGroup& g = groups_[k];
       for (std::uint32_t l = 0; l < g.lanes; ++l) {
         const std::uint32_t body = g.body[l];
-        const Vec2 v = s.velocity[body], flow{g.flow_x[l], g.flow_y[l]};
+        const Vec2 v = s.velocity[body];
         const double w = s.angular_velocity[body];
-        if (w == 0.0 && flow.x == v.x && flow.y == v.y) continue;  // adds_nothing
-        add_slab_bound(sums.rate_bound[body], quiet_[g.entry[l]].moments, flow, v, w);
+        if (lane_adds_nothing(g, l, v, w)) continue;
+        add_slab_bound(sums.rate_bound[body], quiet_[g.entry[l]].moments, {g.flow_x[l], g.flow_y[l]}, v, w);
       }
     }
   });
@@ -706,8 +706,7 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
           // the flow without spin (adds_nothing), the lanes without the Jacobian, else
           // add_entry's own path.
           const std::uint32_t body = g.body[l];
-          const Vec2 v = s.velocity[body];
-          const bool adds = !(s.angular_velocity[body] == 0.0 && g.flow_x[l] == v.x && g.flow_y[l] == v.y);
+          const bool adds = !lane_adds_nothing(g, l, s.velocity[body], s.angular_velocity[body]);
           in = adds && sums.jacobian[body] == 0;
           if (adds && !in) entry(i);
         } else {

@@ -134,6 +134,10 @@ class DistributedDrag final : public ForceTerm {
     double middle_x[kLanes], middle_y[kLanes], weight[kLanes];
   };
   void pack_lanes() const;
+  /// adds_nothing for lane l of a group (one slab, its flow in the group), without the entry's record.
+  static bool lane_adds_nothing(const LaneGroup& g, std::uint32_t l, Vec2 v, double w) {
+    return w == 0.0 && g.flow_x[l] == v.x && g.flow_y[l] == v.y;
+  }
   void add_group(const LaneGroup& g, unsigned mask, const BodyStatesView& state, ForceSums& sums) const;
   struct Quiet {
     std::size_t body;
