@@ -10,8 +10,8 @@ Penetration is shown beside the time: an engine that is faster by letting floes 
 has not won (the issue asks equal or smaller penetration). The benchmark scenes sweep native's
 contacts in colour order (`coloured_sweeps`, plain Gauss-Seidel, 10 sweeps as every engine);
 the other sections run native's defaults (pair order, NNCG). The same trade is swept on the 1k
-field (iterations and dt per engine: cost against mean overlap), and native's step is timed
-on 1 thread up to every core."""
+field (iterations and dt per engine: cost against mean overlap). Every run here is single
+threaded; the thread count is the threads section's."""
 import csv
 import os
 
@@ -35,12 +35,12 @@ def iterations(engine, count):
 
 def config(quick):
     if quick:   # a smoke run of the machinery: the field is not packed yet at 40 s
-        return dict(field=[("1k", 40.0, 20.0)], towing=(60.0, 30.0), scaling=("1k", 40.0, 20.0),
+        return dict(field=[("1k", 40.0, 20.0)], towing=(60.0, 30.0),
                     sweep=dict(duration=40.0, window=20.0, iterations=[3, 30], dts=[0.1]))
     # Packed by about 100 s (99 % of floes in contact); the larger fields are timed over a short
     # window after that, so that the section stays within half an hour on 2 cores.
     return dict(field=[("1k", 150.0, 50.0), ("4k", 150.0, 50.0), ("16k", 110.0, 10.0), ("100k", 105.0, 5.0)],
-                towing=(300.0, 240.0), scaling=("4k", 150.0, 50.0),
+                towing=(300.0, 240.0),
                 sweep=dict(duration=150.0, window=50.0, iterations=[2, 5, 20, 50], dts=[0.025, 0.1, 0.2]))
 
 
@@ -53,15 +53,6 @@ def plan(ctx):
             runs.append(Run(f"speed_field_{size}_{e}", os.path.join(ctx.scenarios, "bench", f"field_wall_{size}.toml"), e,
                             [f"run.duration={duration!r}"], bench_window=window, bench_stages=True,
                             meta=dict(scene="field", size=size)))
-    # Thread scaling: native on the field, 1 thread up to every core (results are the same to
-    # the bit on any number; tests/run/test_determinism.cpp).
-    size, duration_s, window_s = c["scaling"]
-    cores = os.cpu_count() or 1
-    for t in sorted({1, 2, 4, 8, 16, cores}):
-        if t <= cores:
-            runs.append(Run(f"speed_threads_{t}", os.path.join(ctx.scenarios, "bench", f"field_wall_{size}.toml"),
-                            "native", [f"run.duration={duration_s!r}"], bench_window=window_s, threads=t,
-                            bench_stages=True, meta=dict(scene="threads", threads=t)))
     # Run time against error: the 1k field with the iterations and the step swept on every
     # engine (10 iterations at dt 0.05 s is the speed_field_1k run itself).
     sw = c["sweep"]
@@ -89,9 +80,7 @@ def read_row(path):
 def write(ctx):
     timed = [r for r in ctx.all_runs if r.timed and r.tag.startswith("speed_")]
     every = {r.tag: read_row(r.out) for r in timed}
-    rows = {t: r for t, r in every.items() if not t.startswith(("speed_threads_", "speed_sweep_"))}
-    scaling = sorted((int(r["threads"]), float(r["median_ms"])) for t, r in every.items()
-                     if t.startswith("speed_threads_"))
+    rows = {t: r for t, r in every.items() if not t.startswith("speed_sweep_")}
     # All rows in one CSV per report (the machine is in each row).
     with open(os.path.join(ctx.out, "bench.csv"), "w", newline="") as f:
         w = None
@@ -130,21 +119,6 @@ def write(ctx):
     md += ["![ms per step against floes](fig/speed_field.png)", ""]
     md += stages_section(ctx, rows, every)
     md += cost_against_error(ctx, every)
-    if scaling:
-        one = scaling[0][1]
-        md += [f"Threads (native, `{next(r for t, r in every.items() if t.startswith('speed_threads_'))['scenario']}`, "
-               "FLOEDEM_THREADS; the output is the same to the bit on any number): the per-body and per-pair loops "
-               "(drag, forcing, placing, narrow phase, integration) and the contact solve's islands run on the pool, "
-               "and the sweeps of an island too large for one thread (a field packed on a wall is nearly one "
-               "island) run on every thread: colour by colour with the benchmark's `coloured_sweeps` "
-               "(`native/solver/coloured_sweeps.cpp`), pipelined in pair order otherwise "
-               "(`native/solver/sweep_pipeline.cpp`). What stays on one thread bounds the speed-up: the position "
-               "projection, the island grouping, and the large island's colouring, warm start and packing into "
-               "bundles.", "",
-               "| threads | ms per step | speed-up |", "|---|---|---|"]
-        md += [f"| {t} | {ms:.2f} | {one / ms:.2f} |" for t, ms in scaling]
-        md += ["", "![ms per step and speed-up against threads](fig/speed_threads.png)", ""]
-        threads_figure(ctx, scaling, every)
     return md, []
 
 
@@ -168,8 +142,8 @@ STAGE_LABELS = {"forcing": "forcing (environment terms)", "broad_phase": "broad 
 
 def stages_section(ctx, rows, every):
     """Where native's step goes: mean ms per step by stage (`floedem bench` times each stage of
-    every timed step, the stage_ms column), on the field sizes and the towing case, and on 1 and
-    more threads: what a target left unmet would have to shrink, and what does not scale."""
+    every timed step, the stage_ms column), on the field sizes and the towing case: what a target
+    left unmet would have to shrink."""
     runs = [(t, r) for t, r in sorted(rows.items(), key=lambda kv: int(kv[1]["bodies"]))
             if r["engine"] == "native" and stages(r)]
     if not runs:
@@ -209,9 +183,7 @@ def stages_section(ctx, rows, every):
                + ", ".join(f"{STAGE_LABELS[k]} {v:.1f} ms" for k, v in top) + ".", ""]
     md += stages_scaling(rows)
     md += stages_against_box2d(rows)
-    threads = sorted(((int(r["threads"]), r) for t, r in every.items() if t.startswith("speed_threads_") and stages(r)),
-                     key=lambda x: x[0])
-    stages_figure(ctx, runs, names, label, threads)
+    stages_figure(ctx, runs, names, label)
     md += ["![ms per step by stage](fig/speed_stages.png)", ""]
     return md
 
@@ -275,13 +247,13 @@ def stages_against_box2d(rows):
             "|---|---|---|---|---|---|---|---|"] + lines + [""]
 
 
-def stages_figure(ctx, runs, names, label, threads):
-    """Left: each native run's step as shares of its stages. Right: ms per stage against the
-    thread count on the scaling runs (a stage that stays flat runs on one thread)."""
+def stages_figure(ctx, runs, names, label):
+    """Each native run's step as shares of its stages (the stages against threads are in the
+    threads section)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, ax = plt.subplots(figsize=(7, 4.2))
     colours = plt.get_cmap("tab20")(range(len(names)))
     for y, (tag, r) in enumerate(runs):
         st = stages(r)
@@ -297,48 +269,8 @@ def stages_figure(ctx, runs, names, label, threads):
     ax.set_xlim(0, 100)
     ax.set_title("native, one thread: where a step goes", fontsize=9)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=3)
-    if threads:
-        counts = [t for t, _ in threads]
-        for k, n in enumerate(names):
-            ms = [stages(r).get(n, 0.0) for _, r in threads]
-            if max(ms) > 0.01 * sum(stages(threads[0][1]).values()):  # the stages of at least 1 % of the step
-                bx.plot(counts, ms, "o-", color=colours[k], label=STAGE_LABELS[n])
-        bx.set_xticks(counts)
-        bx.set_xlabel("threads (FLOEDEM_THREADS)")
-        bx.set_ylabel("ms per step (mean)")
-        bx.set_ylim(bottom=0)
-        bx.set_title(f"native, {threads[0][1]['scenario']}: stages against threads", fontsize=9)
-        bx.legend(fontsize=7)
-    else:
-        bx.set_axis_off()
     fig.tight_layout()
     fig.savefig(os.path.join(ctx.fig, "speed_stages.png"), dpi=110)
-    plt.close(fig)
-
-
-def threads_figure(ctx, scaling, every):
-    """Native's ms per step and speed-up against the thread count (the scaling runs)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    threads = [t for t, _ in scaling]
-    ms = [m for _, m in scaling]
-    row = next(r for t, r in every.items() if t.startswith("speed_threads_"))
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(9, 3.6))
-    ax.plot(threads, ms, "o-")
-    ax.set_xlabel("threads (FLOEDEM_THREADS)")
-    ax.set_ylabel("ms per step (median)")
-    ax.set_ylim(bottom=0)
-    bx.plot(threads, [ms[0] / m for m in ms], "o-", label="measured")
-    bx.plot(threads, threads, "k:", lw=0.8, label="ideal")
-    bx.set_xlabel("threads (FLOEDEM_THREADS)")
-    bx.set_ylabel("speed-up against 1 thread")
-    bx.legend()
-    for a in (ax, bx):
-        a.set_xticks(threads)
-    fig.suptitle(f"native, {row['scenario']} packed on its wall, {row['cpu']} ({row['host']})", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(os.path.join(ctx.fig, "speed_threads.png"), dpi=110)
     plt.close(fig)
 
 
