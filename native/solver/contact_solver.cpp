@@ -409,6 +409,12 @@ double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const
   resize_with_headroom(work.ends, 2 * nm);
   double deepest = 0.0;
   for (std::size_t i = 0; i < nm; ++i) {
+    // The manifold four on, every line of it asked for ahead: this sweep reads the first line,
+    // each point's and the reference face's (the last), out of cache at 16k floes, and its
+    // hottest load waited on the last line (perf). A prefetch changes no value.
+    if (i + 4 < nm)
+      for (std::size_t line = 0; line < sizeof(Manifold); line += 64)
+        __builtin_prefetch(reinterpret_cast<const char*>(&manifolds[i + 4]) + line);
     work.ends[2 * i] = manifolds[i].body_a;
     work.ends[2 * i + 1] = manifolds[i].body_b;
     deepest = std::max(deepest, measure(i));
