@@ -487,6 +487,7 @@ template <class Group, class FormSlot, class SkinSlot>
 
 void DistributedDrag::pack_lanes() const {
   groups_.clear();
+  lane_moments_.clear();
   form_lanes_.clear();
   skin_lanes_.clear();
   in_lanes_.assign(entries_.size(), 0);
@@ -514,6 +515,7 @@ void DistributedDrag::pack_lanes() const {
                      [&](std::uint32_t a, std::uint32_t b) { return points(a) < points(b); });
   for (std::size_t k = 0; k < single.size(); k += kLanes) {
     LaneGroup g;
+    lane_moments_.resize(lane_moments_.size() + kLanes);
     g.lanes = static_cast<std::uint32_t>(std::min<std::size_t>(kLanes, single.size() - k));
     for (std::uint32_t l = 0; l < g.lanes; ++l) g.slots = std::max(g.slots, points(single[k + l]));
     g.first = static_cast<std::uint32_t>(kind_ == Kind::form ? form_lanes_.size() : skin_lanes_.size());
@@ -528,6 +530,7 @@ void DistributedDrag::pack_lanes() const {
       if (l >= g.lanes) continue;  // read as lane 0, never stored
       laned_[i] = 1;
       const Slab& slab = slabs_[entries_[i].first_slab];
+      lane_moments_[kLanes * groups_.size() + l] = slab.moments;
       g.count[l] = slab.count;
       g.flow_x[l] = slab.drag.flow.x;
       g.flow_y[l] = slab.drag.flow.y;
@@ -593,13 +596,14 @@ void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& 
 
 bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) const {
   if (!lanes_packed_) pack_lanes();
-  if (!lanes_direct()) {
+  if (!lanes_direct(sums)) {
     for_entries(sums, 2048, [&](std::size_t i) { add_entry_bound(i, s, sums); });
     return true;
   }
-  // A moving flow: the lanes' floes from their groups (each body's one slab, read from the
-  // group: the body, its flow and moments, in place of the entry's records), the rest entry
-  // by entry. Each body is written by one of the two loops, with add_entry_bound's arithmetic.
+  // Direct (lanes_direct): the lanes' floes from their groups (each body's one slab: the body
+  // and its flow from the group, its moments from lane_moments_, in the groups' order, in place
+  // of the entry's records), the rest entry by entry. Each body is written by one of the two
+  // loops, with add_entry_bound's arithmetic.
   thread_pool().for_blocks(unlaned_.size(), 2048, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) add_entry_bound(unlaned_[k], s, sums);
   });
@@ -611,7 +615,7 @@ bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) c
         const Vec2 v = s.velocity[body];
         const double w = s.angular_velocity[body];
         if (lane_adds_nothing(g, l, v, w)) continue;
-        add_slab_bound(sums.rate_bound[body], quiet_[g.entry[l]].moments, {g.flow_x[l], g.flow_y[l]}, v, w);
+        add_slab_bound(sums.rate_bound[body], lane_moments_[kLanes * k + l], {g.flow_x[l], g.flow_y[l]}, v, w);
       }
     }
   });
@@ -678,11 +682,11 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
   // each in the same order as one thread would, so the sums do not depend on the threads.
   // The floes that take the lean path are left to the lanes (add_entry marks them), which then
   // add them four at a time: each body's sums are written once, by one of the two loops.
-  // A moving flow (lanes_direct): add_entry visits the entries without a lane alone, and each
-  // group finds its own lanes to add, as add_entry would mark them (the floe adds something
-  // and needs no Jacobian).
+  // Direct (lanes_direct: a moving flow, or many bodies moving): add_entry visits the entries
+  // without a lane alone, and each group finds its own lanes to add, as add_entry would mark
+  // them (the floe adds something and needs no Jacobian).
   if (!lanes_packed_) pack_lanes();
-  const bool direct = lanes_direct();
+  const bool direct = lanes_direct(sums);
   std::atomic<bool> any_jacobian{false};
   auto entry = [&](std::size_t i) {
     if (add_entry(i, s, sums) && !any_jacobian.load(std::memory_order_relaxed))

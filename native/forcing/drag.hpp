@@ -162,14 +162,23 @@ class DistributedDrag final : public ForceTerm {
   // The lanes (pack_lanes), and per entry whether this step's add left it to them.
   mutable bool lanes_packed_ = false;
   mutable std::vector<LaneGroup> groups_;
+  // Each lane's slab moments (rate bound), group by group: read in the groups' order, where
+  // reading them from quiet_ by entry (entries sorted within windows of 64) waited for memory
+  // (perf: two thirds of the rate bound's samples, at 16k floes).
+  mutable std::vector<std::array<double, 4>> lane_moments_;
   mutable std::vector<FormSlot> form_lanes_;
   mutable std::vector<SkinSlot> skin_lanes_;
   mutable std::vector<std::uint8_t> in_lanes_, laned_;  // laned_: the entry has a lane
   mutable std::vector<std::uint32_t> unlaned_;          // the entries without one, in order
-  /// A moving flow (not calm_): every entry is visited each step, so the lanes' floes are
-  /// taken straight from the groups (rate bound and drag), and add_entry / add_entry_bound
-  /// visit the other entries alone (drag.cpp).
-  bool lanes_direct() const { return !calm_ && lanes_packed_; }
+  /// A moving flow (not calm_), or still water or air with a quarter of the entries' bodies
+  /// or more moving (a drifting field's air drag): the lanes' floes are taken straight from
+  /// the groups (rate bound and drag), and add_entry / add_entry_bound visit the other entries
+  /// alone (drag.cpp). Otherwise (the towing case's field, mostly at rest) the moving bodies
+  /// alone are visited, entry by entry. A floe at rest in still water adds nothing on either
+  /// path (adds_nothing, lane_adds_nothing), so both give the same sums to the bit.
+  bool lanes_direct(const ForceSums& sums) const {
+    return lanes_packed_ && (!calm_ || 4 * sums.stirred.size() >= entries_.size());
+  }
 };
 
 /// The term, or nullptr when no body needs it.

@@ -4,8 +4,10 @@
 // Jacobian (two quadrature points at a time for quadratic drag) is Q with it, to the bit.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 #include "forcing/drag.hpp"
@@ -230,7 +232,9 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
   // 37 floes (nine groups of four and one lane more), 3 to 9 corners, some with a zero-length
   // edge, in one term: most take the four-floe lanes (one slab, no Jacobian, quadratic drag);
   // some need the Jacobian, some have two slabs, and in still water some are at rest and not
-  // visited; in a moving flow some move with it without spin (nothing to add). Each floe's
+  // visited (most of them moving, which takes the groups directly as a moving flow does, or
+  // most at rest, which visits the moving ones entry by entry: DistributedDrag::lanes_direct);
+  // in a moving flow some move with it without spin (nothing to add). Each floe's
   // sums, started from another term's, must be the point-by-point rule's to the bit, over two
   // steps (the lanes' marks of the first must not leak into the second).
   std::mt19937_64 rng(29);
@@ -240,9 +244,10 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
   for (const LaneIsa isa : available_lane_isas()) {
     use_lane_isa(isa);
     for (const bool rotational : {true, false})
-      for (const bool still : {false, true})
+      for (const int mode : {0, 1, 2})  // a moving flow; still, most floes moving; still, most at rest
         for (const auto kind : {DistributedDrag::Kind::form, DistributedDrag::Kind::skin}) {
-          INFO("isa " << static_cast<int>(isa) << " rotational " << rotational << " still " << still << " form "
+          const bool still = mode != 0;
+          INFO("isa " << static_cast<int>(isa) << " rotational " << rotational << " mode " << mode << " form "
                       << (kind == DistributedDrag::Kind::form));
           EnvironmentSpec env;
           env.rotational_damping = rotational;
@@ -271,7 +276,7 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
             ForceSums sums = sums_for(n);
             sums.stirred.clear();
             for (std::size_t i = 0; i < n; ++i) {
-              const bool rests = still && (i + static_cast<std::size_t>(step)) % 6 == 2;
+              const bool rests = still && ((i + static_cast<std::size_t>(step)) % 6 == 2) == (mode == 1);
               const bool with_flow = !still && (i + static_cast<std::size_t>(step)) % 10 == 3;
               s.velocity[i] = rests ? Vec2{} : with_flow ? slabs[i].front().flow : Vec2{0.8 * u(rng), 0.8 * u(rng)};
               s.angular_velocity[i] = rests || with_flow ? 0.0 : 0.02 * u(rng);
@@ -281,7 +286,28 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
               sums.q[i] = {1e3 * u(rng), 1e3 * u(rng), 1e4 * u(rng)};  // another term's sums
               if (!rests) sums.stirred.push_back(static_cast<std::int32_t>(i));
             }
+            if (mode == 1) REQUIRE(4 * sums.stirred.size() >= n);  // the groups directly
+            if (mode == 2) REQUIRE(4 * sums.stirred.size() < n);   // the moving floes, entry by entry
             const ForceSums before = sums;
+            if (mode == 2) {
+              // The same state with every floe listed as stirred (a floe at rest listed costs a
+              // look) takes the direct path: the same sums and rate bounds to the bit.
+              ForceSums entry_by_entry = sums, direct = sums;
+              direct.stirred.resize(n);
+              std::iota(direct.stirred.begin(), direct.stirred.end(), 0);
+              for (ForceSums* x : {&entry_by_entry, &direct}) {
+                drag.add(s, 0.0, *x);
+                std::fill(x->rate_bound.begin(), x->rate_bound.end(), std::array<double, 2>{});
+                REQUIRE(drag.add_rate_bound(s, *x));
+              }
+              for (std::size_t i = 0; i < n; ++i)
+                for (int k = 0; k < 3; ++k) {
+                  CHECK(std::bit_cast<std::uint64_t>(direct.q[i][k]) == std::bit_cast<std::uint64_t>(entry_by_entry.q[i][k]));
+                  if (k < 2)
+                    CHECK(std::bit_cast<std::uint64_t>(direct.rate_bound[i][k]) ==
+                          std::bit_cast<std::uint64_t>(entry_by_entry.rate_bound[i][k]));
+                }
+            }
             drag.add(s, 0.0, sums);
             for (std::size_t i = 0; i < n; ++i) {
               INFO("floe " << i);
