@@ -50,9 +50,10 @@ def floedem_text(floedem, *args):
 
 
 def git_commit():
-    # A copy of the tree without its .git (a machine lent for one run) names its commit here.
-    if os.environ.get("FLOEDEM_SOURCE_COMMIT") and not os.path.isdir(os.path.join(ROOT, ".git")):
-        return os.environ["FLOEDEM_SOURCE_COMMIT"] + " (FLOEDEM_SOURCE_COMMIT: a copy of the tree without .git)"
+    # A copy of the tree whose .git is absent or not its own (a machine lent for one run) is
+    # given its commit here.
+    if os.environ.get("FLOEDEM_SOURCE_COMMIT"):
+        return os.environ["FLOEDEM_SOURCE_COMMIT"] + " (as given by FLOEDEM_SOURCE_COMMIT)"
     try:
         c = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
         d = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
