@@ -346,6 +346,92 @@ std::size_t bundles_of(const std::array<std::size_t, kColours + 1>& count) {
   return bundles;
 }
 
+// Every field of lane `lane` of bundle b from manifold i (c), but the bundle's point count; with
+// `empty_second`, its second point as a lane without one (the bundle sweeps two points, the
+// manifold has one). The rest of the lanes are written by empty_lane.
+void pack_lane(SweepBundle& b, int lane, const Manifold& c, std::size_t i, const BodyArrays& s, bool empty_second) {
+  b.manifold[lane] = static_cast<std::int32_t>(i);
+  b.body_a[lane] = c.body_a;
+  b.body_b[lane] = c.body_b;
+  b.nx[lane] = c.normal.x;
+  b.ny[lane] = c.normal.y;
+  b.friction[lane] = c.friction;
+  b.ma[lane] = s.inv_mass[c.body_a];
+  b.ia[lane] = s.inv_inertia[c.body_a];
+  b.mb[lane] = s.inv_mass[c.body_b];
+  b.ib[lane] = s.inv_inertia[c.body_b];
+  for (int k = 0; k < c.point_count; ++k) {
+    const ManifoldPoint& q = c.points[k];
+    BundlePoint& p = b.point[k];
+    p.rax[lane] = q.ra.x;
+    p.ray[lane] = q.ra.y;
+    p.rbx[lane] = q.rb.x;
+    p.rby[lane] = q.rb.y;
+    p.wnn[lane] = q.wnn;
+    p.wnt[lane] = q.wnt;
+    p.wtt[lane] = q.wtt;
+    lane_reciprocals(p, lane, q.wnn, q.wnt, q.wtt, c.friction);
+    p.target[lane] = q.target_velocity;
+    p.normal_impulse[lane] = q.normal_impulse;
+    p.tangent_impulse[lane] = q.tangent_impulse;
+  }
+  if (empty_second) empty_point(b.point[1], lane);
+}
+
+// The packing of a large solve on the pool's threads (an island of this many manifolds or more,
+// its colours swept on every thread): on one thread it took 8 % of the packed 16k field's step,
+// and on 16 threads, with the rest of the step spread, a sixth of it.
+constexpr std::size_t kThreadedPacking = 4096;
+constexpr std::size_t kPackingBlock = 1024;            // manifolds a block of the threaded packing
+constexpr std::int32_t kEmptiesSecond = 1 << 30;       // in a slot: empty_second for pack_lane
+
+// gather_bundles' loop on the pool's threads, the same bundles and velocities to the bit: first,
+// on this thread, each manifold's slot (its bundle and lane, as the loop takes them) into its
+// colour's place in `space.overflow` (read already; a solve may overwrite the colours), and each
+// bundle's point count, in the loop's order; then the lanes, blocks of manifolds on the pool's
+// threads, while one of them applies the warm start manifold by manifold in the given order (it
+// writes only the bodies' velocities, which the lanes do not read: the same velocities as the
+// loop's, whatever the threads).
+template <class EmptiesSecond>
+void gather_on_threads(const Selection& m, BodyArrays& s, bool warm_start, bool two_points_first,
+                       const SweepSpace& space, const std::array<std::size_t, kColours>& first,
+                       std::array<std::size_t, kColours>& next_two, std::array<std::size_t, kColours>& next_one,
+                       EmptiesSecond&& empties_second) {
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const std::int32_t written = space.overflow[i];
+    const auto colour = static_cast<std::size_t>(colour_of(written));
+    const bool two = (written & kTwoPoints) != 0;
+    const std::size_t n = two_points_first && two ? next_two[colour]++ : next_one[colour]++;
+    const std::size_t bundle = first[colour] + n / kBundleLanes;
+    SweepBundle& b = space.bundles[bundle];
+    if (n % kBundleLanes == 0) b.points = 0;
+    b.points = std::max(b.points, two ? 2 : 1);
+    space.overflow[i] = static_cast<std::int32_t>(kBundleLanes * bundle + n % kBundleLanes) +
+                        (!two && empties_second(colour, n) ? kEmptiesSecond : 0);
+  }
+  const std::size_t blocks = (m.size() + kPackingBlock - 1) / kPackingBlock;
+  thread_pool().for_blocks(blocks + 1, 1, [&](std::size_t block, std::size_t) {
+    if (block == 0) {  // the warm start, in the given order
+      for (std::size_t i = 0; warm_start && i < m.size(); ++i) {
+        const Manifold& c = m[i];
+        const Vec2 t = perp(c.normal);
+        for (int k = 0; k < c.point_count; ++k) {
+          const ManifoldPoint& q = c.points[k];
+          if (q.normal_impulse != 0.0 || q.tangent_impulse != 0.0)
+            apply_impulse(s, c, q, 1.0 * (q.normal_impulse * c.normal + q.tangent_impulse * t));
+        }
+      }
+      return;
+    }
+    const std::size_t begin = (block - 1) * kPackingBlock, end = std::min(m.size(), begin + kPackingBlock);
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::int32_t slot = space.overflow[i] & (kEmptiesSecond - 1);
+      pack_lane(space.bundles[static_cast<std::size_t>(slot / kBundleLanes)], slot % kBundleLanes, m[i], i, s,
+                (space.overflow[i] & kEmptiesSecond) != 0);
+    }
+  });
+}
+
 // With `two_points_first`, each colour's manifolds of two points are placed before those of
 // one, each kind in the given order: a bundle sweeps as many points as its manifold with the
 // most, so bundles of one kind sweep fewer (the 1k field's packed contacts: 62 % have one
@@ -354,7 +440,7 @@ std::size_t bundles_of(const std::array<std::size_t, kColours + 1>& count) {
 // only NNCG's merit, |dP|^2 summed lane by lane, would round otherwise, so with `accelerate`
 // the solve keeps the given order.
 Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool two_points_first,
-                        const SweepSpace& space) {
+                        const SweepSpace& space, bool threads) {
   // Each manifold's colour in overflow[i], made here unless colour_manifolds made it.
   std::array<std::size_t, kColours + 1> count{}, two{};
   if (space.colours_given) {
@@ -378,7 +464,17 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
   }
   g.colour_start[kColours] = g.bundles;
   if (g.bundles > space.bundles.size()) throw std::logic_error("solve_velocities: no room for the coloured bundles");
-  for (std::size_t i = 0; i < m.size(); ++i) {
+  // A one-point manifold's second point is emptied only in a bundle that sweeps two points:
+  // placed two-point first, a bundle past the colour's two-point manifolds sweeps point 0
+  // alone, and its second point is left as it was (16 doubles a lane, not written or read).
+  auto empties_second = [&](std::size_t colour, std::size_t n) {
+    return n - n % kBundleLanes < (two_points_first ? two[colour] : count[colour]);
+  };
+  // A large solve swept on the threads (and nothing beyond the colours) is packed on them too.
+  const bool on_threads =
+      threads && count[kColours] == 0 && m.size() >= kThreadedPacking && thread_pool().size() > 1;
+  if (on_threads) gather_on_threads(m, s, warm_start, two_points_first, space, first, next_two, next_one, empties_second);
+  for (std::size_t i = 0; !on_threads && i < m.size(); ++i) {
     const Manifold& c = m[i];
     const Vec2 t = perp(c.normal);
     auto warm = [&](const ManifoldPoint& q) {
@@ -399,42 +495,12 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
     const std::size_t n = two_points_first && c.point_count == 2 ? next_two[colour]++ : next_one[colour]++;
     SweepBundle& b = space.bundles[first[colour] + n / kBundleLanes];
     const auto lane = static_cast<int>(n % kBundleLanes);
-    // Every field of a lane is written below (or by empty_lane); lane 0 resets the bundle's
-    // point count. Where the two lists meet, lane 0 (two points) may be written after a later
-    // lane (one point): its count, 2, is the bundle's either way.
+    // Lane 0 resets the bundle's point count. Where the two lists meet, lane 0 (two points) may
+    // be written after a later lane (one point): its count, 2, is the bundle's either way.
     if (lane == 0) b.points = 0;
-    b.manifold[lane] = static_cast<std::int32_t>(i);
-    b.body_a[lane] = c.body_a;
-    b.body_b[lane] = c.body_b;
     b.points = std::max(b.points, static_cast<std::int32_t>(c.point_count));
-    b.nx[lane] = c.normal.x;
-    b.ny[lane] = c.normal.y;
-    b.friction[lane] = c.friction;
-    b.ma[lane] = s.inv_mass[c.body_a];
-    b.ia[lane] = s.inv_inertia[c.body_a];
-    b.mb[lane] = s.inv_mass[c.body_b];
-    b.ib[lane] = s.inv_inertia[c.body_b];
-    for (int k = 0; k < c.point_count; ++k) {
-      const ManifoldPoint& q = c.points[k];
-      BundlePoint& p = b.point[k];
-      p.rax[lane] = q.ra.x;
-      p.ray[lane] = q.ra.y;
-      p.rbx[lane] = q.rb.x;
-      p.rby[lane] = q.rb.y;
-      p.wnn[lane] = q.wnn;
-      p.wnt[lane] = q.wnt;
-      p.wtt[lane] = q.wtt;
-      lane_reciprocals(p, lane, q.wnn, q.wnt, q.wtt, c.friction);
-      p.target[lane] = q.target_velocity;
-      p.normal_impulse[lane] = q.normal_impulse;
-      p.tangent_impulse[lane] = q.tangent_impulse;
-      warm(q);
-    }
-    // A one-point lane's second point is swept only in a bundle with a two-point lane: placed
-    // two-point first, a bundle past the colour's two-point manifolds sweeps point 0 alone,
-    // and its second point is left as it was (16 doubles a lane, not written or read).
-    if (c.point_count == 1 && n - n % kBundleLanes < (two_points_first ? two[colour] : count[colour]))
-      empty_point(b.point[1], lane);
+    pack_lane(b, lane, c, i, s, c.point_count == 1 && empties_second(colour, n));
+    for (int k = 0; k < c.point_count; ++k) warm(c.points[k]);
   }
   for (int c = 0; c < kColours; ++c) {  // the lanes left in each colour's last bundle
     const std::size_t n = count[static_cast<std::size_t>(c)];
@@ -567,7 +633,7 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
   if (space.rows.size() < 2 * m.size() || space.overflow.size() < m.size() ||
       space.body_colours.size() < s.inv_mass.size() || (accelerate && space.change.size() < 4 * m.size()))
     throw std::logic_error("solve_velocities: the sweep space has no room for the coloured sweeps");
-  const Gathered g = gather_bundles(m, s, warm_start, /*two_points_first=*/!accelerate && !given_order, space);
+  const Gathered g = gather_bundles(m, s, warm_start, /*two_points_first=*/!accelerate && !given_order, space, threads);
   const std::span<SweepBundle> bundles = space.bundles.first(g.bundles);
   const std::span<SweepRow> rows = space.rows.first(g.rows);
   std::span<double> change, direction, step;

@@ -40,7 +40,8 @@ namespace floedem {
 /// the manifolds, the scene's body_colours (all zero, and left so) and, with `accelerate`,
 /// bundle_change/direction/step (SweepWork::reserve with colour_bodies).
 /// With `threads`, each colour's bundles are swept on the pool's threads (not from inside a
-/// loop of the pool): the same impulses to the bit as without. Without `accelerate`, each
+/// loop of the pool), and a solve of 4 096 manifolds or more is packed into its bundles there
+/// too: the same impulses to the bit as without. Without `accelerate`, each
 /// colour's manifolds of two points take its first bundles unless `given_order` (the same
 /// impulses to the bit, in fewer bundle-points: coloured_sweeps.cpp).
 int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& bodies,
