@@ -88,8 +88,8 @@ def write(ctx):
           "a wall is nearly one island) run on every thread: colour by colour with the benchmark's "
           "`coloured_sweeps` (`native/solver/coloured_sweeps.cpp`), pipelined in pair order otherwise "
           "(`native/solver/sweep_pipeline.cpp`). What stays on one thread bounds the speed-up: the position "
-          "projection, the island grouping, and the large island's colouring, warm start and packing into bundles "
-          "(the stages' table below).", ""]
+          "projection, the island grouping, and the large island's colouring and warm start, while its packing into "
+          "bundles runs on the other threads (the stages' table below).", ""]
     sizes = sorted(rows, key=lambda s: int(rows[s][0][1]["bodies"]))
     md += ["| threads | " + " | ".join(f"field {s}: ms per step | speed-up" for s in sizes) + " |",
            "|---|" + "---|---|" * len(sizes)]
