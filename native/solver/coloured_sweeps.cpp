@@ -346,6 +346,13 @@ std::size_t bundles_of(const std::array<std::size_t, kColours + 1>& count) {
   return bundles;
 }
 
+// The warm start of point q of manifold c (t = perp(c.normal)): its accumulated impulse applied,
+// as apply_accumulated_impulses with +1 (contact_solver.cpp).
+void warm_point(BodyArrays& s, const Manifold& c, Vec2 t, const ManifoldPoint& q) {
+  if (q.normal_impulse != 0.0 || q.tangent_impulse != 0.0)
+    apply_impulse(s, c, q, 1.0 * (q.normal_impulse * c.normal + q.tangent_impulse * t));
+}
+
 // Every field of lane `lane` of bundle b from manifold i (c), but the bundle's point count; with
 // `empty_second`, its second point as a lane without one (the bundle sweeps two points, the
 // manifold has one). The rest of the lanes are written by empty_lane.
@@ -388,27 +395,21 @@ constexpr std::size_t kPackingBlock = 1024;            // manifolds a block of t
 constexpr std::int32_t kEmptiesSecond = 1 << 30;       // in a slot: empty_second for pack_lane
 
 // gather_bundles' loop on the pool's threads, the same bundles and velocities to the bit: first,
-// on this thread, each manifold's slot (its bundle and lane, as the loop takes them) into its
-// colour's place in `space.overflow` (read already; a solve may overwrite the colours), and each
-// bundle's point count, in the loop's order; then the lanes, blocks of manifolds on the pool's
-// threads, while one of them applies the warm start manifold by manifold in the given order (it
-// writes only the bodies' velocities, which the lanes do not read: the same velocities as the
-// loop's, whatever the threads).
-template <class EmptiesSecond>
-void gather_on_threads(const Selection& m, BodyArrays& s, bool warm_start, bool two_points_first,
-                       const SweepSpace& space, const std::array<std::size_t, kColours>& first,
-                       std::array<std::size_t, kColours>& next_two, std::array<std::size_t, kColours>& next_one,
-                       EmptiesSecond&& empties_second) {
+// on this thread, each manifold's slot (its bundle and lane, from `place` as the loop takes
+// them) into its colour's place in `space.overflow` (read already; a solve may overwrite the
+// colours); then the lanes, blocks of manifolds on the pool's threads, while one of them
+// applies the warm start manifold by manifold in the given order (it writes only the bodies'
+// velocities, which the lanes do not read: the same velocities as the loop's, whatever the
+// threads).
+template <class Place, class EmptiesSecond>
+void gather_on_threads(const Selection& m, BodyArrays& s, bool warm_start, const SweepSpace& space,
+                       const std::array<std::size_t, kColours>& first, Place&& place, EmptiesSecond&& empties_second) {
   for (std::size_t i = 0; i < m.size(); ++i) {
     const std::int32_t written = space.overflow[i];
     const auto colour = static_cast<std::size_t>(colour_of(written));
     const bool two = (written & kTwoPoints) != 0;
-    const std::size_t n = two_points_first && two ? next_two[colour]++ : next_one[colour]++;
-    const std::size_t bundle = first[colour] + n / kBundleLanes;
-    SweepBundle& b = space.bundles[bundle];
-    if (n % kBundleLanes == 0) b.points = 0;
-    b.points = std::max(b.points, std::int32_t{two ? 2 : 1});
-    space.overflow[i] = static_cast<std::int32_t>(kBundleLanes * bundle + n % kBundleLanes) +
+    const std::size_t n = place(colour, two ? 2 : 1);
+    space.overflow[i] = static_cast<std::int32_t>(kBundleLanes * first[colour] + n) +
                         (!two && empties_second(colour, n) ? kEmptiesSecond : 0);
   }
   const std::size_t blocks = (m.size() + kPackingBlock - 1) / kPackingBlock;
@@ -417,11 +418,7 @@ void gather_on_threads(const Selection& m, BodyArrays& s, bool warm_start, bool 
       for (std::size_t i = 0; warm_start && i < m.size(); ++i) {
         const Manifold& c = m[i];
         const Vec2 t = perp(c.normal);
-        for (int k = 0; k < c.point_count; ++k) {
-          const ManifoldPoint& q = c.points[k];
-          if (q.normal_impulse != 0.0 || q.tangent_impulse != 0.0)
-            apply_impulse(s, c, q, 1.0 * (q.normal_impulse * c.normal + q.tangent_impulse * t));
-        }
+        for (int k = 0; k < c.point_count; ++k) warm_point(s, c, t, c.points[k]);
       }
       return;
     }
@@ -472,16 +469,26 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
   auto empties_second = [&](std::size_t colour, std::size_t n) {
     return n - n % kBundleLanes < (two_points_first ? two[colour] : count[colour]);
   };
+  // The next place in its colour (n: bundle first[colour] + n / 4, lane n % 4) of a manifold of
+  // `points` points, taken in the manifolds' order; its bundle's point count kept. Lane 0 resets
+  // it. Where the two lists meet, lane 0 (two points) may be taken after a later lane (one
+  // point): its count, 2, is the bundle's either way.
+  auto place = [&](std::size_t colour, int points) {
+    const std::size_t n = two_points_first && points == 2 ? next_two[colour]++ : next_one[colour]++;
+    SweepBundle& b = space.bundles[first[colour] + n / kBundleLanes];
+    if (n % kBundleLanes == 0) b.points = 0;
+    b.points = std::max(b.points, static_cast<std::int32_t>(points));
+    return n;
+  };
   // A large solve swept on the threads (and nothing beyond the colours) is packed on them too.
   const bool on_threads = threads && count[kColours] == 0 && m.size() >= kThreadedPacking &&
                           m.size() < kThreadedPackingMost && thread_pool().size() > 1;
-  if (on_threads) gather_on_threads(m, s, warm_start, two_points_first, space, first, next_two, next_one, empties_second);
+  if (on_threads) gather_on_threads(m, s, warm_start, space, first, place, empties_second);
   for (std::size_t i = 0; !on_threads && i < m.size(); ++i) {
     const Manifold& c = m[i];
     const Vec2 t = perp(c.normal);
     auto warm = [&](const ManifoldPoint& q) {
-      if (warm_start && (q.normal_impulse != 0.0 || q.tangent_impulse != 0.0))
-        apply_impulse(s, c, q, 1.0 * (q.normal_impulse * c.normal + q.tangent_impulse * t));
+      if (warm_start) warm_point(s, c, t, q);
     };
     const auto colour = static_cast<std::size_t>(colour_of(space.overflow[i]));
     if (colour == kColours) {  // no colour left: rows, swept after the bundles
@@ -494,14 +501,9 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
       }
       continue;
     }
-    const std::size_t n = two_points_first && c.point_count == 2 ? next_two[colour]++ : next_one[colour]++;
-    SweepBundle& b = space.bundles[first[colour] + n / kBundleLanes];
-    const auto lane = static_cast<int>(n % kBundleLanes);
-    // Lane 0 resets the bundle's point count. Where the two lists meet, lane 0 (two points) may
-    // be written after a later lane (one point): its count, 2, is the bundle's either way.
-    if (lane == 0) b.points = 0;
-    b.points = std::max(b.points, static_cast<std::int32_t>(c.point_count));
-    pack_lane(b, lane, c, i, s, c.point_count == 1 && empties_second(colour, n));
+    const std::size_t n = place(colour, c.point_count);
+    pack_lane(space.bundles[first[colour] + n / kBundleLanes], static_cast<int>(n % kBundleLanes), c, i, s,
+              c.point_count == 1 && empties_second(colour, n));
     for (int k = 0; k < c.point_count; ++k) warm(c.points[k]);
   }
   for (int c = 0; c < kColours; ++c) {  // the lanes left in each colour's last bundle
