@@ -77,18 +77,22 @@ def read_row(path):
     return rows[-1]
 
 
+def write_rows(path, rows):
+    """Bench rows (dicts of one header, the machine in each) into one CSV file."""
+    rows = list(rows)
+    with open(path, "w", newline="") as f:
+        if rows:
+            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+            w.writeheader()
+            w.writerows(rows)
+
+
 def write(ctx):
     timed = [r for r in ctx.all_runs if r.timed and r.tag.startswith("speed_")]
     every = {r.tag: read_row(r.out) for r in timed}
     rows = {t: r for t, r in every.items() if not t.startswith("speed_sweep_")}
     # All rows in one CSV per report (the machine is in each row).
-    with open(os.path.join(ctx.out, "bench.csv"), "w", newline="") as f:
-        w = None
-        for tag in sorted(every):
-            if w is None:
-                w = csv.DictWriter(f, fieldnames=list(every[tag].keys()))
-                w.writeheader()
-            w.writerow(every[tag])
+    write_rows(os.path.join(ctx.out, "bench.csv"), (every[tag] for tag in sorted(every)))
     any_row = next(iter(rows.values()))
     md = ["## Speed", "",
           f"`floedem bench`, one run at a time on {any_row['cpu']} ({any_row['host']}), single thread per engine; "

@@ -9,11 +9,10 @@ checks 1 against 4 threads on every CI run, this checks every core of the report
 On 2 cores the scaling runs are the 4k field; where there are 8 cores or more the 16k field is
 timed too. The 16-core figures of the committed report come from `floedem report --only threads`
 run on a 16-core machine (reports/threads-16/README.md says which and how)."""
-import csv
 import os
 
 from report_runner import Run
-from sections.speed import STAGE_LABELS, stages
+from sections.speed import STAGE_LABELS, read_row, stages, write_rows
 
 # The benchmark's own settings (colour order, 10 plain sweeps), and native's defaults (pair order,
 # 50 sweeps followed by NNCG steps, up to 450 more where a point still closes too fast).
@@ -61,7 +60,6 @@ def read_bytes(path):
 
 
 def write(ctx):
-    from sections.speed import read_row
     cores = os.cpu_count() or 1
     rows = {}   # size -> [(threads, row)]
     for r in ctx.all_runs:
@@ -71,14 +69,7 @@ def write(ctx):
         v.sort(key=lambda x: x[0])
     if not rows:
         return [], []
-    with open(os.path.join(ctx.out, "threads.csv"), "w", newline="") as f:   # every scaling row (machine in each)
-        w = None
-        for size in rows:
-            for _, row in rows[size]:
-                if w is None:
-                    w = csv.DictWriter(f, fieldnames=list(row.keys()))
-                    w.writeheader()
-                w.writerow(row)
+    write_rows(os.path.join(ctx.out, "threads.csv"), (row for size in rows for _, row in rows[size]))
     any_row = next(iter(rows.values()))[0][1]
     md = ["## Threads", "",
           f"Native on 1 to {cores} threads (FLOEDEM_THREADS) on {any_row['cpu']} ({any_row['host']}), `floedem bench "
