@@ -3,7 +3,10 @@
 // (the `bench` target does this).
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <random>
+#include <string>
 
 #include "engine/registry.hpp"
 #include "field/field_generator.hpp"
@@ -192,6 +195,19 @@ BENCHMARK(BM_FieldGenerator)->Arg(10000)->Arg(100000)->Iterations(1)->Unit(bench
 /// and the engine's flip tolerance; its contacts are classified, and solved once from zero for a
 /// warm start. The step, sweep limits and overlap are the scenario's. Made once.
 struct PackedField {
+  // FLOEDEM_BENCH_FIELD=4k or 16k: that field instead (its contacts out of cache; made in
+  // about a minute at 16k).
+  static std::string field_size() {
+    const char* const size = std::getenv("FLOEDEM_BENCH_FIELD");
+    if (size == nullptr || *size == '\0') return "1k";
+    const std::string s = size;
+    if (s != "1k" && s != "4k" && s != "16k") {
+      std::fprintf(stderr, "floedem_bench: FLOEDEM_BENCH_FIELD must be 1k, 4k or 16k (scenarios/bench/field_wall_*.toml), not '%s'\n",
+                   s.c_str());
+      std::exit(2);
+    }
+    return s;
+  }
   Scene scene;
   NativeSettings settings;
   SweepLimits limits;
@@ -210,7 +226,7 @@ struct PackedField {
   }
 
   PackedField()
-      : scene(load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml",
+      : scene(load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_" + field_size() + ".toml",
                             {"run.duration=100.0"})),
         settings(read_native_settings(scene)),
         limits{settings.velocity_iterations, settings.tolerance},
