@@ -634,7 +634,7 @@ void NativeEngine::solve_contacts() {
   if (settings_.coloured_sweeps) {
     // The islands coloured first, so that each island's bundles get a slice of exactly their
     // number (a bound per island, bundles_for, came to a bundle a manifold for the many small
-    // islands: 1 280 bytes each, and a total that grew as the pack broke up and closed again).
+    // islands: a 768-byte bundle each, and a total that grew as the pack broke up and closed again).
     resize_with_headroom(island_bundles_, n + 1);
     island_bundles_[0] = 0;
     for (std::size_t i = 0; i < n; ++i) {

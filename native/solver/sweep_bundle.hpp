@@ -9,23 +9,18 @@ namespace floedem {
 
 inline constexpr int kBundleLanes = 4;
 
-/// One contact point of each of a bundle's manifolds, lane by lane.
+/// One contact point of each of a bundle's manifolds, lane by lane: what the sweeps read and
+/// write ten times a step. The Delassus block and the local solve's reciprocals are made from
+/// these and the bundle's normal and inverse masses as each point is swept (coloured_sweeps.cpp).
 struct BundlePoint {
   double rax[kBundleLanes], ray[kBundleLanes], rbx[kBundleLanes], rby[kBundleLanes];  ///< lever arms
-  double wnn[kBundleLanes], wnt[kBundleLanes], wtt[kBundleLanes];                       ///< Delassus block
-  // The local solve's divisors as reciprocals, fixed for the step (NaN where a slide's divisor
-  // is not positive: that case never holds).
-  double inv_det[kBundleLanes];             ///< 1 / (W_nn W_tt - W_nt^2)
-  double inv_wnn[kBundleLanes], inv_wtt[kBundleLanes];
-  double inv_slide_plus[kBundleLanes];      ///< 1 / (W_nn - mu W_nt): sliding with s = +1
-  double inv_slide_minus[kBundleLanes];     ///< 1 / (W_nn + mu W_nt): s = -1
   double target[kBundleLanes];  ///< m/s; -inf where the lane has no such point (no impulse ever)
   double normal_impulse[kBundleLanes], tangent_impulse[kBundleLanes];  ///< accumulated, N s
 };
 
 /// Up to four manifolds of one colour (no two share a moving body), structure of arrays. An
 /// empty lane reads lane 0's bodies, has zero inverse masses (never written back) and no impulse.
-/// 1 280 bytes: 320 a manifold against two 112-byte rows in pair order.
+/// 768 bytes: 192 a manifold against two 112-byte rows in pair order.
 struct alignas(64) SweepBundle {
   std::int32_t body_a[kBundleLanes], body_b[kBundleLanes];
   std::int32_t manifold[kBundleLanes];  ///< each lane's manifold (its place in the solve), -1 if none
@@ -35,6 +30,7 @@ struct alignas(64) SweepBundle {
   double ma[kBundleLanes], ia[kBundleLanes], mb[kBundleLanes], ib[kBundleLanes];  ///< 1/m, 1/I; 0: not written
   BundlePoint point[2];
 };
+static_assert(sizeof(SweepBundle) == 768);
 
 /// Room enough for the bundles of a coloured solve of `manifolds` manifolds: a colour of k
 /// manifolds takes ceil(k / 4) bundles, at most k, over 63 colours (the rest are swept as rows):
