@@ -278,7 +278,8 @@ double largest_shortfall_of(std::span<const SweepBundle> bundles, const BodyArra
   return worst;
 }
 
-// A lane's point that is not there: no impulse ever (need <= 0), finite arithmetic.
+// A lane's point that is not there: no impulse ever (need = -inf <= 0 selects zero, whatever
+// else the lane computes: an empty lane's zero masses give a zero Delassus block, so infinities).
 void empty_point(BundlePoint& p, int l) {
   p.rax[l] = p.ray[l] = p.rbx[l] = p.rby[l] = 0.0;
   p.target[l] = -std::numeric_limits<double>::infinity();
