@@ -65,22 +65,16 @@ FLOEDEM_LANES void apply(const SweepBundle& b, const BundlePoint& p, v4d px, v4d
 // A point's Delassus block and the local solve's reciprocals, lane by lane, made as the point is
 // swept rather than stored in its bundle: a bundle is 768 bytes instead of 1 280, and the sweeps
 // stream every bundle ten times a step (out of cache at 16k floes, from memory at 100k). The
-// block is prepare_contact's operations (contact_solver.cpp) in its order on the same lever
-// arms, normal and inverse masses, and each reciprocal is correctly rounded, so every impulse is
-// the same to the bit as with the values stored. The divisions run beside the sweep's chain of
+// block is delassus_block (contact_solver.hpp), prepare_contact's own, on the same lever arms,
+// normal and inverse masses, and each reciprocal is correctly rounded, so every impulse is the
+// same to the bit as with the values stored. The divisions run beside the sweep's chain of
 // dependent operations. Measured (2-core Intel VM, builds side by side): the 100k field's
 // contact solve 93.8 -> 72.5 and 85.5 -> 66.7 ms a step (two rounds, the cores swapped); in cache (the
 // 1k field's BM_ContactSweepsColoured, alternating pairs) about 5 % slower.
-struct Delassus {
-  v4d wnn, wnt, wtt;
-};
+using Delassus = DelassusBlock<v4d>;
 FLOEDEM_LANES Delassus delassus(const SweepBundle& b, const BundlePoint& p, v4d nx, v4d ny) {
-  const v4d ma = load(b.ma), ia = load(b.ia), mb = load(b.mb), ib = load(b.ib);
-  const v4d rax = load(p.rax), ray = load(p.ray), rbx = load(p.rbx), rby = load(p.rby);
-  const v4d rna = rax * ny - ray * nx, rnb = rbx * ny - rby * nx;    // cross(r, n)
-  const v4d rta = rax * nx - ray * -ny, rtb = rbx * nx - rby * -ny;  // cross(r, t), t = perp(n) = (-n_y, n_x)
-  return {ma + mb + ia * rna * rna + ib * rnb * rnb, ia * rna * rta + ib * rnb * rtb,
-          ma + mb + ia * rta * rta + ib * rtb * rtb};
+  return delassus_block(load(b.ma), load(b.ia), load(b.mb), load(b.ib), load(p.rax), load(p.ray), load(p.rbx),
+                        load(p.rby), nx, ny);
 }
 
 // local_impulse (sweep_row.hpp) on four lanes: each case's impulse computed, then the first

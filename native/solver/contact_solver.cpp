@@ -43,18 +43,16 @@ LocalImpulse solve_single_contact(double ufn, double uft, double target, double 
 void prepare_contact(Manifold& m, const BodyArrays& s, double dt, double collision_threshold) {
   const int a = m.body_a, b = m.body_b;
   const Vec2 n = m.normal;
-  const Vec2 t = perp(n);
   const double ma = s.inv_mass[a], mb = s.inv_mass[b];
   const double ia = s.inv_inertia[a], ib = s.inv_inertia[b];
   for (int k = 0; k < m.point_count; ++k) {
     ManifoldPoint& p = m.points[k];
     p.ra = p.point - s.position[a];
     p.rb = p.point - s.position[b];
-    const double rna = cross(p.ra, n), rnb = cross(p.rb, n);
-    const double rta = cross(p.ra, t), rtb = cross(p.rb, t);
-    p.wnn = ma + mb + ia * rna * rna + ib * rnb * rnb;
-    p.wtt = ma + mb + ia * rta * rta + ib * rtb * rtb;
-    p.wnt = ia * rna * rta + ib * rnb * rtb;
+    const DelassusBlock<double> w = delassus_block(ma, ia, mb, ib, p.ra.x, p.ra.y, p.rb.x, p.rb.y, n.x, n.y);
+    p.wnn = w.wnn;
+    p.wnt = w.wnt;
+    p.wtt = w.wtt;
     p.approach_velocity = dot(relative_velocity(s, a, b, p.ra, p.rb), n);
     const double gap = std::max(p.separation, 0.0);
     // A collision: a new contact, approaching faster than the threshold, reached within the

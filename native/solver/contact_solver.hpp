@@ -24,6 +24,24 @@ inline Vec2 relative_velocity(const BodyArrays& s, int a, int b, Vec2 ra, Vec2 r
   return (s.velocity[b] + cross(s.angular_velocity[b], rb)) - (s.velocity[a] + cross(s.angular_velocity[a], ra));
 }
 
+/// A point's Delassus block W_nn = n.M^-1 n, W_nt = n.M^-1 t, W_tt = t.M^-1 t (t = perp(n)):
+/// W = (m_a + m_b) I + i_a (r_a x .)^2 + i_b (r_b x .)^2 for inverse masses m and inertias i
+/// and lever arms r (contact_solver.cpp). One definition for prepare_contact (doubles) and the
+/// coloured sweeps (four lanes, coloured_sweeps.cpp), so that both make the same values to the
+/// bit: the same operations in the same order.
+template <class T>
+struct DelassusBlock {
+  T wnn, wnt, wtt;
+};
+template <class T>
+[[gnu::always_inline]] inline DelassusBlock<T> delassus_block(T ma, T ia, T mb, T ib, T rax, T ray, T rbx, T rby, T nx,
+                                                              T ny) {
+  const T rna = rax * ny - ray * nx, rnb = rbx * ny - rby * nx;    // cross(r, n)
+  const T rta = rax * nx - ray * -ny, rtb = rbx * nx - rby * -ny;  // cross(r, t), t = (-n_y, n_x)
+  return {ma + mb + ia * rna * rna + ib * rnb * rnb, ia * rna * rta + ib * rnb * rtb,
+          ma + mb + ia * rta * rta + ib * rtb * rtb};
+}
+
 /// Classifies each point of m (collision or resting) from its approach velocity and gap, sets
 /// its target normal velocity, and fills the Delassus block. A collision's impulses start from
 /// zero (Newton's law fixes them; a warm start's guess would be a resting impulse's).
