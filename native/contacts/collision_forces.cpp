@@ -97,34 +97,82 @@ CollisionTracker::Event CollisionTracker::open_event(double t_end, const StepPai
   return e;
 }
 
-void CollisionTracker::observe(double t_end, std::span<const ContactRecord> contacts, const BodyStates& after,
-                               std::vector<CollisionRow>& finished) {
-  ++step_;
-  // This step's contacts summed by pair (a pair's points need not be adjacent in the list:
-  // concave bodies are several convex parts).
+void CollisionTracker::sum_by_pair(std::span<const ContactRecord> contacts) {
+  // This step's contacts summed by pair, each pair's records in their order in the list (so
+  // the sums do not depend on how the pairs are interleaved). A pair's points need not be
+  // adjacent (concave bodies are several convex parts; a reference engine lists its contacts
+  // in its own order): the records are then taken in a stable sort by pair.
   step_pairs_.clear();
-  for (const ContactRecord& c : contacts) {
-    StepPair& p = step_pairs_[{c.body_a, c.body_b}];
-    p.a = c.body_a;
-    p.b = c.body_b;
+  auto add = [&](const ContactRecord& c) {
+    if (step_pairs_.empty() || step_pairs_.back().a != c.body_a || step_pairs_.back().b != c.body_b) {
+      StepPair& fresh = step_pairs_.emplace_back();
+      fresh.a = c.body_a;
+      fresh.b = c.body_b;
+    }
+    StepPair& p = step_pairs_.back();
     if (c.normal_impulse > 0.0) p.impulse += c.normal_impulse;
     // What starts an event: an impulse at a point approaching faster than the threshold
     // (the engines' collision kind; a compliant engine's records say the same).
     const bool impact = model_ == DurationModel::estimated ? c.kind == ContactKind::collision
                                                            : -c.approach_velocity > threshold_;
-    if (!impact || !(c.normal_impulse > 0.0)) continue;
+    if (!impact || !(c.normal_impulse > 0.0)) return;
     p.collision_impulse += c.normal_impulse;
     p.weighted_point += c.normal_impulse * c.point;
     p.weighted_normal += c.normal_impulse * c.normal;
     p.weighted_approach += c.normal_impulse * -c.approach_velocity;
+  };
+  auto key = [&](std::size_t k) { return PairKey{contacts[k].body_a, contacts[k].body_b}; };
+  std::size_t k = 1;
+  while (k < contacts.size() && !(key(k) < key(k - 1))) ++k;
+  if (k >= contacts.size()) {
+    for (const ContactRecord& c : contacts) add(c);
+    return;
   }
-  for (const auto& [key, p] : step_pairs_) {
-    auto it = open_.find(key);
-    if (it == open_.end()) {
+  order_.resize(contacts.size());
+  for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<std::int32_t>(i);
+  std::stable_sort(order_.begin(), order_.end(), [&](std::int32_t x, std::int32_t y) {
+    return key(static_cast<std::size_t>(x)) < key(static_cast<std::size_t>(y));
+  });
+  for (const std::int32_t i : order_) add(contacts[static_cast<std::size_t>(i)]);
+}
+
+std::int32_t CollisionTracker::store(const Event& event) {
+  if (free_slots_.empty()) {
+    events_.push_back(event);
+    return static_cast<std::int32_t>(events_.size() - 1);
+  }
+  const std::int32_t slot = free_slots_.back();
+  free_slots_.pop_back();
+  events_[static_cast<std::size_t>(slot)] = event;
+  return slot;
+}
+
+void CollisionTracker::observe(double t_end, std::span<const ContactRecord> contacts, const BodyStates& after,
+                               std::vector<CollisionRow>& finished) {
+  ++step_;
+  sum_by_pair(contacts);
+  // The step's pairs merged with the open events, both in pair order: a pair with a collision
+  // impulse and no open event opens one; an open event whose pair has contact force this step
+  // goes on; one whose pair has none (no contact, or contact without force) has separated and
+  // ends. Ended events are appended in pair order.
+  next_open_.clear();
+  std::size_t i = 0, j = 0;
+  auto end_event = [&](const OpenEvent& o) {
+    finished.push_back(complete(events_[static_cast<std::size_t>(o.slot)], after));
+    free_slots_.push_back(o.slot);
+  };
+  while (j < step_pairs_.size()) {
+    const StepPair& p = step_pairs_[j++];
+    const PairKey key{p.a, p.b};
+    for (; i < open_.size() && open_[i].key < key; ++i) end_event(open_[i]);
+    OpenEvent o{key, 0};
+    if (i < open_.size() && open_[i].key == key) {
+      o.slot = open_[i++].slot;
+    } else {
       if (!(p.collision_impulse > 0.0)) continue;  // resting contact only: no event
-      it = open_.emplace(key, open_event(t_end, p, after)).first;
+      o.slot = store(open_event(t_end, p, after));
     }
-    Event& e = it->second;
+    Event& e = events_[static_cast<std::size_t>(o.slot)];
     if (model_ == DurationModel::estimated) {
       e.row.normal_impulse += p.collision_impulse;
     } else {
@@ -132,16 +180,13 @@ void CollisionTracker::observe(double t_end, std::span<const ContactRecord> cont
       e.peak_step_impulse = std::max(e.peak_step_impulse, p.impulse);
     }
     if (p.impulse > 0.0) e.last_step = step_;
+    if (e.last_step == step_)
+      next_open_.push_back(o);
+    else
+      end_event(o);
   }
-  // Pairs with no contact force this step have separated: their events end.
-  for (auto it = open_.begin(); it != open_.end();) {
-    if (it->second.last_step == step_) {
-      ++it;
-      continue;
-    }
-    finished.push_back(complete(it->second, after));
-    it = open_.erase(it);
-  }
+  for (; i < open_.size(); ++i) end_event(open_[i]);
+  std::swap(open_, next_open_);
 }
 
 CollisionRow CollisionTracker::complete(const Event& e, const BodyStates& now) const {
@@ -165,8 +210,10 @@ CollisionRow CollisionTracker::complete(const Event& e, const BodyStates& now) c
 }
 
 void CollisionTracker::finish(const BodyStates& now, std::vector<CollisionRow>& finished) {
-  for (const auto& [key, event] : open_) finished.push_back(complete(event, now));
+  for (const OpenEvent& o : open_) finished.push_back(complete(events_[static_cast<std::size_t>(o.slot)], now));
   open_.clear();
+  events_.clear();
+  free_slots_.clear();
 }
 
 void CollisionTracker::save(StateWriter& out) const {
@@ -174,10 +221,11 @@ void CollisionTracker::save(StateWriter& out) const {
   out.tag("collisions");
   out.value(step_);
   out.value(static_cast<std::uint64_t>(open_.size()));
-  for (const auto& [key, e] : open_) {
+  for (const OpenEvent& o : open_) {
+    const Event& e = events_[static_cast<std::size_t>(o.slot)];
     const CollisionRow& r = e.row;
-    out.value(key.first);
-    out.value(key.second);
+    out.value(o.key.first);
+    out.value(o.key.second);
     for (const double v : {r.time, r.normal_impulse, r.effective_mass, r.approach_speed, r.restitution_achieved,
                            r.duration, r.mean_force, r.peak_force, e.peak_step_impulse})
       out.value(v);
@@ -195,6 +243,8 @@ void CollisionTracker::restore(StateReader& in) {
   const auto n = in.value<std::uint64_t>();
   if (n > in.left()) throw StateError("checkpoint: truncated");
   open_.clear();
+  events_.clear();
+  free_slots_.clear();
   for (std::uint64_t k = 0; k < n; ++k) {
     PairKey key;
     in.value(key.first);
@@ -209,7 +259,8 @@ void CollisionTracker::restore(StateReader& in) {
     in.value(e.first_step);
     in.value(e.last_step);
     for (Vec2* v : {&e.normal, &e.local_a, &e.local_b}) in.value(*v);
-    open_.emplace_hint(open_.end(), key, e);
+    if (!open_.empty() && !(open_.back().key < key)) throw StateError("checkpoint: collision events out of pair order");
+    open_.push_back({key, store(e)});
   }
 }
 

@@ -6,6 +6,7 @@
 // round-off of the mass properties and of the impulse-weighted contact point, nothing more.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -142,5 +143,76 @@ TEST_CASE("collision forces: [contact] takes duration_coefficient or stiffness, 
                                   std::string("stiffness = -1\n"), std::string("duration_coefficient = 0\n")}) {
     INFO(bad);
     CHECK_THROWS_AS(test::scene_from(run + "[contact]\n" + bad + body), InputError);
+  }
+}
+
+TEST_CASE("collision forces: events from hand-made records, in any order of the list", "[contacts]") {
+  // Three floes apart (their states only give the effective masses). Records made by hand, step
+  // by step: pair (0, 1) collides at step 1, is pressed at step 2 (its event goes on) and
+  // touches without force at step 3 (it has separated: its event ends there); pair (1, 2) rests
+  // at step 1 (no event), collides at step 2 and is still open when the run ends; pair (0, 2)
+  // collides at step 3 with its two points apart in the list.
+  const BodyText a{"a", test::box({0.0, 0.0}, 10.0, 10.0), {}, 0.0};
+  const BodyText b{"b", test::box({20.0, 0.0}, 10.0, 10.0), {}, 0.0};
+  const BodyText c{"c", test::box({40.0, 0.0}, 10.0, 10.0), {}, 0.0};
+  const Scene s = test::scene_from(scene_text(0.01, 0.0, 1.5e-4, {a, b, c}));
+  const Stepper stepper(s, "native");
+  const BodyStates& at = stepper.state();
+  auto record = [](std::int32_t i, std::int32_t j, double impulse, ContactKind kind, Vec2 point) {
+    ContactRecord r;
+    r.body_a = i;
+    r.body_b = j;
+    r.point = point;
+    r.normal = {1.0, 0.0};
+    r.normal_impulse = impulse;
+    r.approach_velocity = kind == ContactKind::collision ? -0.5 : 0.0;
+    r.kind = kind;
+    return r;
+  };
+  const auto hit = ContactKind::collision, rest = ContactKind::resting;
+  const std::vector<std::vector<ContactRecord>> steps = {
+      {record(0, 1, 100.0, hit, {10.0, 1.0}), record(0, 1, 0.1, hit, {10.0, -1.0}), record(1, 2, 5.0, rest, {30.0, 0.0})},
+      {record(0, 1, 7.0, rest, {10.0, 0.0}), record(1, 2, 30.0, hit, {30.0, 2.0})},
+      {record(0, 2, 0.3, hit, {20.0, 1.0}), record(0, 1, 0.0, rest, {10.0, 0.0}), record(0, 2, 1e-17, hit, {20.0, -1.0}),
+       record(1, 2, 2.0, rest, {30.0, 0.0})},
+  };
+  auto run = [&](bool reversed) {
+    CollisionTracker tracker(s);
+    std::vector<CollisionRow> rows;
+    std::vector<std::size_t> ended_at;
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      std::vector<ContactRecord> list = steps[k];
+      if (reversed) std::reverse(list.begin(), list.end());
+      tracker.observe(0.01 * static_cast<double>(k + 1), list, at, rows);
+      ended_at.push_back(rows.size());
+    }
+    tracker.finish(at, rows);
+    return std::pair{rows, ended_at};
+  };
+  const auto [rows, ended_at] = run(false);
+  CHECK(ended_at == std::vector<std::size_t>{0, 0, 1});  // (0, 1) ends at step 3, the rest at the end
+  REQUIRE(rows.size() == 3);
+  CHECK((rows[0].body_a == 0 && rows[0].body_b == 1));
+  CHECK(rows[0].time == 0.01);
+  CHECK(rows[0].normal_impulse == 100.0 + 0.1);  // collision impulses only: the pressing at step 2 adds nothing
+  CHECK(rows[0].approach_speed == Approx(0.5).epsilon(1e-15));  // impulse-weighted over its two points
+  // The finished ones in pair order: (0, 2) before (1, 2).
+  CHECK((rows[1].body_a == 0 && rows[1].body_b == 2));
+  CHECK(rows[1].time == 0.03);
+  CHECK(rows[1].normal_impulse == 0.3 + 1e-17);
+  CHECK((rows[2].body_a == 1 && rows[2].body_b == 2));
+  CHECK(rows[2].time == 0.02);
+  CHECK(rows[2].normal_impulse == 30.0);
+  // The list in reverse: a pair's records are no longer adjacent and the pairs are out of order;
+  // the sums take each pair's records in list order, so only (0, 1)'s two points at step 1 and
+  // (0, 2)'s at step 3 are added the other way round (exact here), and the events are the same.
+  const auto [back_rows, back_ended_at] = run(true);
+  CHECK(back_ended_at == ended_at);
+  REQUIRE(back_rows.size() == rows.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    CHECK(back_rows[k].body_a == rows[k].body_a);
+    CHECK(back_rows[k].body_b == rows[k].body_b);
+    CHECK(back_rows[k].normal_impulse == rows[k].normal_impulse);
+    CHECK(back_rows[k].effective_mass == rows[k].effective_mass);
   }
 }
