@@ -2,7 +2,8 @@
 floes 5-30 m at 50 % drifting onto a wall until nearly every floe touches another) and of the
 paper's towing case, on every engine, by `floedem bench`: one run at a time after all other runs
 of the report, one process per run, the median over the timed window (the packed state), with
-allocations per step and peak memory. Each run's CSV row is in runs/TAG.csv and all rows in
+allocations per step and peak memory. The 16k field's native and Box2D runs are timed again in
+the other order (config's `again`), and its targets are judged on every round. Each run's CSV row is in runs/TAG.csv and all rows in
 bench.csv. The issue's targets are shown against what was measured; they are goals for the
 solver, not agreement checks, so a target missed is reported here and is not a disagreement.
 
@@ -34,14 +35,21 @@ def iterations(engine, count):
 
 
 def config(quick):
+    # again: the field size whose native and Box2D runs are timed a second time, in the other
+    # order, right after the first round: a virtual machine's speed drifts (by up to 1.7x within
+    # an hour, README "Speed"), and the 16k ratio is a target, so it is taken from two pairs of
+    # adjacent runs (native, box2d ... box2d, native), not from one.
     if quick:   # a smoke run of the machinery: the field is not packed yet at 40 s
-        return dict(field=[("1k", 40.0, 20.0)], towing=(60.0, 30.0),
+        return dict(field=[("1k", 40.0, 20.0)], again="1k", towing=(60.0, 30.0),
                     sweep=dict(duration=40.0, window=20.0, iterations=[3, 30], dts=[0.1]))
     # Packed by about 100 s (99 % of floes in contact); the larger fields are timed over a short
     # window after that, so that the section stays within half an hour on 2 cores.
     return dict(field=[("1k", 150.0, 50.0), ("4k", 150.0, 50.0), ("16k", 110.0, 10.0), ("100k", 105.0, 5.0)],
-                towing=(300.0, 240.0),
+                again="16k", towing=(300.0, 240.0),
                 sweep=dict(duration=150.0, window=50.0, iterations=[2, 5, 20, 50], dts=[0.025, 0.1, 0.2]))
+
+
+AGAIN_ENGINES = ["box2d", "native"]   # the second round's order: the first round's reversed
 
 
 def plan(ctx):
@@ -53,6 +61,11 @@ def plan(ctx):
             runs.append(Run(f"speed_field_{size}_{e}", os.path.join(ctx.scenarios, "bench", f"field_wall_{size}.toml"), e,
                             [f"run.duration={duration!r}"], bench_window=window, bench_stages=True,
                             meta=dict(scene="field", size=size)))
+        if size == c["again"]:   # timing runs go one at a time in plan order: these follow the first round
+            for e in (e for e in AGAIN_ENGINES if e in ctx.engines):
+                runs.append(Run(f"speed_again_{size}_{e}", os.path.join(ctx.scenarios, "bench", f"field_wall_{size}.toml"),
+                                e, [f"run.duration={duration!r}"], bench_window=window, bench_stages=True,
+                                meta=dict(scene="again", size=size)))
     # Run time against error: the 1k field with the iterations and the step swept on every
     # engine (10 iterations at dt 0.05 s is the speed_field_1k run itself).
     sw = c["sweep"]
@@ -90,7 +103,8 @@ def write_rows(path, rows):
 def write(ctx):
     timed = [r for r in ctx.all_runs if r.timed and r.tag.startswith("speed_")]
     every = {r.tag: read_row(r.out) for r in timed}
-    rows = {t: r for t, r in every.items() if not t.startswith("speed_sweep_")}
+    rows = {t: r for t, r in every.items() if not t.startswith(("speed_sweep_", "speed_again_"))}
+    again = {t: r for t, r in every.items() if t.startswith("speed_again_")}
     # All rows in one CSV per report (the machine is in each row).
     write_rows(os.path.join(ctx.out, "bench.csv"), (every[tag] for tag in sorted(every)))
     any_row = next(iter(rows.values()))
@@ -118,7 +132,8 @@ def write(ctx):
                   f"{100 * float(row['contact_fraction']):.1f} % | {1e3 * float(row['max_penetration_m']):.2f} | "
                   f"{float(row['allocations_per_step']):.3g} | {float(row['peak_rss_mb']):.0f} |")
     md.append("")
-    md += targets(rows)
+    md += repeated(rows, again)
+    md += targets(rows, again)
     figure(ctx, rows)
     md += ["![ms per step against floes](fig/speed_field.png)", ""]
     md += stages_section(ctx, rows, every)
@@ -278,22 +293,66 @@ def stages_figure(ctx, runs, names, label):
     plt.close(fig)
 
 
-def targets(rows):
-    """The issue's targets against what this report measured."""
+def repeated(rows, again):
+    """The second round of the repeated field size against the first: how far a timing on this
+    machine moves between runs of the same build, and the native-to-Box2D ratio of each pair of
+    adjacent runs."""
+    if not again:
+        return []
+    size = next(iter(again)).split("_")[2]   # speed_again_SIZE_ENGINE
+    out = [f"Timed again (the {size} field, native and Box2D in the other order, right after the first round; "
+           "the runs of a pair are adjacent in time, so their ratio sees the machine at one speed):", "",
+           "| engine | first round (ms, median) | second round | second / first |", "|---|---|---|---|"]
+    for e in AGAIN_ENGINES:
+        first, second = rows.get(f"speed_field_{size}_{e}"), again.get(f"speed_again_{size}_{e}")
+        if first and second:
+            a, b = float(first["median_ms"]), float(second["median_ms"])
+            out.append(f"| {e} | {a:.2f} | {b:.2f} | {b / a:.2f} |")
+    ratios = round_ratios(rows, again, size, "box2d")
+    if ratios:
+        out += ["", "Box2D over native, per round: " + ", ".join(f"{r:.2f}x" for r in ratios) + "."]
+    return out + [""]
+
+
+def round_ratios(rows, again, size, engine):
+    """engine's median over native's, in each round that timed both (the first round, then the
+    second where the report timed one)."""
+    out = []
+    for table, prefix in ((rows, "speed_field"), (again, "speed_again")):
+        mine, other = table.get(f"{prefix}_{size}_native"), table.get(f"{prefix}_{size}_{engine}")
+        if mine and other:
+            out.append(float(other["median_ms"]) / float(mine["median_ms"]))
+    return out
+
+
+def targets(rows, again):
+    """The issue's targets against what this report measured. The 16k field's: each engine's
+    speed ratio in every round that timed it (the lowest decides) and the penetration beside it
+    (the issue asks equal or smaller)."""
     def ms(tag):
         return float(rows[tag]["median_ms"]) if tag in rows else None
 
     out = ["Issue 8's targets, as measured here:", ""]
 
-    def versus(scene, targets, label):
+    def versus(scene, targets, label, size=None):
         mine = ms(f"speed_{scene}_native")
         for e, factor in targets.items():
             other = ms(f"speed_{scene}_{e}")
-            if mine and other:
+            if not (mine and other):
+                continue
+            if size is None:
                 out.append(f"- {label}: native {other / mine:.2f}x faster than {e} (target {factor:g}x): "
                            f"{'met' if other / mine >= factor else 'not met'}.")
+                continue
+            ratios = round_ratios(rows, again, size, e)
+            depth = [1e3 * float(rows[f"speed_{scene}_{x}"]["max_penetration_m"]) for x in ("native", e)]
+            shallower = depth[0] <= depth[1]
+            rounds = " and ".join(f"{r:.2f}x" for r in ratios)
+            out.append(f"- {label}: native {rounds} faster than {e} ({'two rounds' if len(ratios) > 1 else 'one round'}; "
+                       f"target {factor:g}x), max penetration {depth[0]:.2f} mm against {depth[1]:.2f}: "
+                       f"{'met' if min(ratios) >= factor and shallower else 'not met'}.")
 
-    versus("field_16k", TARGET_VS, "16 000 floes")
+    versus("field_16k", TARGET_VS, "16 000 floes", size="16k")
     n100 = ms("speed_field_100k_native")
     if n100:
         out.append(f"- 100 000 floes: {n100:.1f} ms per step on native (target at most {TARGET_100K_MS:g}): "
