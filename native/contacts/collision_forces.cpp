@@ -130,8 +130,10 @@ void CollisionTracker::sum_by_pair(std::span<const ContactRecord> contacts) {
   }
   order_.resize(contacts.size());
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<std::int32_t>(i);
-  std::stable_sort(order_.begin(), order_.end(), [&](std::int32_t x, std::int32_t y) {
-    return key(static_cast<std::size_t>(x)) < key(static_cast<std::size_t>(y));
+  // Stable by the index as the tie-break (std::stable_sort would allocate a buffer each step).
+  std::sort(order_.begin(), order_.end(), [&](std::int32_t x, std::int32_t y) {
+    const PairKey kx = key(static_cast<std::size_t>(x)), ky = key(static_cast<std::size_t>(y));
+    return kx < ky || (kx == ky && x < y);
   });
   for (const std::int32_t i : order_) add(contacts[static_cast<std::size_t>(i)]);
 }
