@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing, builds, runs the default scenario on every engine
 # (native, box2d, bullet, ode), printing each run's summary, and ends with the cross-engine
-# report (`floedem report`: about 45 minutes on 2 cores; exit 5 when it finds engines disagreeing). Outputs go to results/; the report to
+# report (`floedem report`: about 45 to 55 minutes on 2 cores; exit 5 when it finds engines disagreeing). Outputs go to results/; the report to
 # results/report/REPORT.md.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
