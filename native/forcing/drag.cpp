@@ -492,6 +492,7 @@ void DistributedDrag::pack_lanes() const {
   skin_lanes_.clear();
   in_lanes_.assign(entries_.size(), 0);
   laned_.assign(entries_.size(), 0);
+  group_of_entry_.assign(entries_.size(), 0);
   unlaned_.clear();
   lanes_packed_ = true;
   auto list_unlaned = [&] {
@@ -529,6 +530,7 @@ void DistributedDrag::pack_lanes() const {
       g.body[l] = static_cast<std::uint32_t>(entries_[i].body);
       if (l >= g.lanes) continue;  // read as lane 0, never stored
       laned_[i] = 1;
+      group_of_entry_[i] = static_cast<std::uint32_t>(groups_.size());
       const Slab& slab = slabs_[entries_[i].first_slab];
       lane_moments_[kLanes * groups_.size() + l] = slab.moments;
       g.count[l] = slab.count;
@@ -555,6 +557,7 @@ void DistributedDrag::pack_lanes() const {
     }
     groups_.push_back(g);
   }
+  group_listed_.assign(groups_.size(), 0);
   list_unlaned();
 }
 
@@ -692,15 +695,32 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
     if (add_entry(i, s, sums) && !any_jacobian.load(std::memory_order_relaxed))
       any_jacobian.store(true, std::memory_order_relaxed);
   };
-  if (direct)
+  if (direct) {
     thread_pool().for_blocks(unlaned_.size(), 512, [&](std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) entry(unlaned_[k]);
     });
-  else
+  } else {
     for_entries(sums, 512, entry);
-  thread_pool().for_blocks(groups_.size(), 128, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      const LaneGroup& g = groups_[k];
+    // The groups that add_entry left a lane to, in group order: the others add nothing (each
+    // of their floes is at rest, or was added entry by entry), and each group writes its own
+    // floes, so leaving them out changes no sum.
+    groups_to_add_.clear();
+    if (!groups_.empty())
+      for (const std::int32_t body : sums.stirred) {
+        const auto b = static_cast<std::size_t>(body);
+        if (b >= entry_of_body_.size() || entry_of_body_[b] < 0) continue;
+        const auto i = static_cast<std::size_t>(entry_of_body_[b]);
+        if (in_lanes_[i] == 0 || group_listed_[group_of_entry_[i]] != 0) continue;
+        group_listed_[group_of_entry_[i]] = 1;
+        groups_to_add_.push_back(group_of_entry_[i]);
+      }
+    std::sort(groups_to_add_.begin(), groups_to_add_.end());
+    for (const std::uint32_t k : groups_to_add_) group_listed_[k] = 0;
+  }
+  const std::size_t group_count = direct ? groups_.size() : groups_to_add_.size();
+  thread_pool().for_blocks(group_count, 128, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t n = begin; n < end; ++n) {
+      const LaneGroup& g = groups_[direct ? n : groups_to_add_[n]];
       unsigned mask = 0;
       for (std::uint32_t l = 0; l < g.lanes; ++l) {
         const std::uint32_t i = g.entry[l];

@@ -169,6 +169,12 @@ class DistributedDrag final : public ForceTerm {
   mutable std::vector<FormSlot> form_lanes_;
   mutable std::vector<SkinSlot> skin_lanes_;
   mutable std::vector<std::uint8_t> in_lanes_, laned_;  // laned_: the entry has a lane
+  // Where the moving bodies alone are visited (not lanes_direct): each laned entry's group, and
+  // the groups this step's add left a lane to (listed once each: group_listed_), so that the
+  // groups of floes at rest are not looked at (the towing case: 5 245 floes, some 400 moving).
+  mutable std::vector<std::uint32_t> group_of_entry_;
+  mutable std::vector<std::uint8_t> group_listed_;
+  mutable std::vector<std::uint32_t> groups_to_add_;
   mutable std::vector<std::uint32_t> unlaned_;          // the entries without one, in order
   /// A moving flow (not calm_), or still water or air with a quarter of the entries' bodies
   /// or more moving (a drifting field's air drag): the lanes' floes are taken straight from

@@ -144,6 +144,56 @@ TEST_CASE("drag: in still water only the moving bodies are visited, with the sum
   }
 }
 
+TEST_CASE("drag: in still water a few floes moving among many take their lane groups alone, to the bit",
+          "[forcing]") {
+  // Forty floes of one outline (so ten lane groups of four, in entry order), a few of them
+  // moving: under a quarter moving, the term visits the moving floes alone and adds the groups
+  // they fall in, no other (DistributedDrag::add). Each moving floe must get the point-by-point
+  // rule's force to the bit, each floe at rest exactly nothing; three steps with other floes
+  // moving, so that a group left out after being added (or added twice) shows.
+  const std::vector<Vec2> poly{{-5.0, -3.0}, {6.0, -4.0}, {4.0, 5.0}, {-6.0, 2.0}};
+  constexpr std::size_t n = 40;
+  for (const auto kind : {DistributedDrag::Kind::form, DistributedDrag::Kind::skin}) {
+    EnvironmentSpec env;
+    DistributedDrag drag("still", kind, env);
+    BodyStates s;
+    s.resize(n);
+    for (std::size_t i = 0; i < n; ++i) drag.add_body(i, poly, {{400.0, 1.0, {0.0, 0.0}}});
+    const std::vector<EdgePoint> edges = edge_points(poly);
+    const std::vector<AreaPoint> points = area_points(poly);
+    const DragSettings settings{env.rotational_damping, env.drag_reference_speed};
+    for (const std::vector<std::int32_t>& moving :
+         {std::vector<std::int32_t>{2, 3, 17, 39}, std::vector<std::int32_t>{17}, std::vector<std::int32_t>{0, 1, 2, 3, 38}}) {
+      ForceSums sums = sums_for(n);
+      sums.jacobian.assign(n, 0);  // force alone: the lanes' path
+      sums.stirred = moving;
+      for (std::size_t i = 0; i < n; ++i) {
+        s.velocity[i] = {};
+        s.angular_velocity[i] = 0.0;
+        s.angle[i] = 0.1 * static_cast<double>(i);
+        sums.rotation[i] = Rot::from_angle(s.angle[i]);
+      }
+      for (const std::int32_t m : moving) {
+        s.velocity[m] = {0.3 - 0.01 * m, -0.1};
+        s.angular_velocity[m] = 0.01 * (m % 3);
+      }
+      drag.add(s, 0.0, sums);
+      for (std::size_t i = 0; i < n; ++i) {
+        INFO("floe " << i << " of " << moving.size() << " moving");
+        BodySum expected{};
+        if (std::find(moving.begin(), moving.end(), static_cast<std::int32_t>(i)) != moving.end()) {
+          if (kind == DistributedDrag::Kind::form)
+            add_form_drag(expected, edges, 1.0, 400.0, {}, s.velocity[i], s.angular_velocity[i], sums.rotation[i], settings, false);
+          else
+            add_skin_drag(expected, points, 1.0, 400.0, {}, s.velocity[i], s.angular_velocity[i], sums.rotation[i], settings, false);
+          REQUIRE(expected.q != std::array<double, 3>{});
+        }
+        CHECK(sums.q[i] == expected.q);
+      }
+    }
+  }
+}
+
 TEST_CASE("forcing: in still water with Coriolis the moving bodies alone give every body's loads to the bit",
           "[forcing]") {
   // After its first step a Forcing whose terms are all idle at rest (still-water drag,
