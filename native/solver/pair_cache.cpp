@@ -61,24 +61,39 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
   else if (!moved_list_.empty())
     refresh(body, fixed);
   // The pairs of this step: candidates whose step boxes overlap (candidates are sorted), found
-  // by blocks of candidates on the pool's threads and joined in block order.
+  // by blocks of candidates on the pool's threads and joined in block order. Each candidate is
+  // written to the block's next place and the count moved on by whether its boxes overlap
+  // (Aabb::overlaps' four comparisons, all made): no branch on the data, which went either way
+  // from one candidate to the next. The towing case's broad phase (perf samples of find_pairs,
+  // 7.9 % -> 5.1 % of the run; the same pairs).
   constexpr std::size_t kGrain = 16384;
   const std::size_t blocks = (candidates_.size() + kGrain - 1) / kGrain;
   if (overlapping_.size() < blocks) overlapping_.resize(blocks);
+  if (overlapping_count_.size() < blocks) overlapping_count_.resize(blocks);
   thread_pool().for_blocks(candidates_.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<PartPair>& found = overlapping_[begin / kGrain];
-    found.clear();
-    for (std::size_t k = begin; k < end; ++k)
-      if (boxes[candidates_[k].a].overlaps(boxes[candidates_[k].b])) found.push_back(candidates_[k]);
+    if (found.size() < end - begin) found.resize(kGrain);  // once: a block is never longer
+    std::size_t count = 0;
+    for (std::size_t k = begin; k < end; ++k) {
+      const PartPair c = candidates_[k];
+      const Aabb& a = boxes[c.a];
+      const Aabb& b = boxes[c.b];
+      found[count] = c;
+      count += static_cast<std::size_t>((a.lo.x <= b.hi.x) & (b.lo.x <= a.hi.x) & (a.lo.y <= b.hi.y) & (b.lo.y <= a.hi.y));
+    }
+    overlapping_count_[begin / kGrain] = count;
   });
   // Room for all first (and half as many again): joined by range inserts alone, the list was
   // reallocated here on 0.148 of the packed 4k field's steps (traced; 0.004 allocations a step
   // in all with this).
   std::size_t total = 0;
-  for (std::size_t b = 0; b < blocks; ++b) total += overlapping_[b].size();
+  for (std::size_t b = 0; b < blocks; ++b) total += overlapping_count_[b];
   reserve_with_headroom(out, total);
   out.clear();
-  for (std::size_t b = 0; b < blocks; ++b) out.insert(out.end(), overlapping_[b].begin(), overlapping_[b].end());
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const auto first = overlapping_[b].begin();
+    out.insert(out.end(), first, first + static_cast<std::ptrdiff_t>(overlapping_count_[b]));
+  }
 }
 
 void PairCache::parts_near(const Aabb& box, std::vector<std::int32_t>& out) const {

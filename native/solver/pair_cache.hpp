@@ -52,7 +52,8 @@ class PairCache {
   std::vector<std::uint8_t> moved_;     // fat box changed this step
   std::vector<std::int32_t> moved_list_;
   std::vector<std::uint8_t> left_;      // left its fat box this step
-  std::vector<std::vector<PartPair>> overlapping_;  // per block of candidates: the pairs it found
+  std::vector<std::vector<PartPair>> overlapping_;  // per block of candidates: room for all, the pairs it found first
+  std::vector<std::size_t> overlapping_count_;      // ... and how many
   std::vector<PartPair> candidates_, kept_, fresh_;
   std::vector<std::int32_t> hits_;
   std::int64_t rebuilds_ = 0;
