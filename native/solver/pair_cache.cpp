@@ -133,12 +133,22 @@ void PairCache::refresh(std::span<const std::int32_t> body, std::span<const std:
   }
   std::sort(fresh_.begin(), fresh_.end());
   fresh_.erase(std::unique(fresh_.begin(), fresh_.end()), fresh_.end());
-  // Old candidates of the moved parts go; the rest stay; both lists are sorted: merge.
-  kept_.clear();
-  for (const PartPair& p : candidates_)
-    if (!moved_[p.a] && !moved_[p.b]) kept_.push_back(p);
-  resize_with_headroom(candidates_, kept_.size() + fresh_.size());
-  std::merge(kept_.begin(), kept_.end(), fresh_.begin(), fresh_.end(), candidates_.begin());
+  // Old candidates of the moved parts go; the rest stay; both lists are sorted: merged in one
+  // pass into the spare list, which becomes the candidates (the old ones the spare). The
+  // same list as std::merge of the kept and the fresh (no pair is in both: a fresh pair has a
+  // moved part, a kept one none), in one read and one write of it instead of two each: a few
+  // parts leave their fat boxes on most steps of the towing case, whose list is a field's.
+  resize_with_headroom(kept_, candidates_.size() + fresh_.size());
+  auto out = kept_.begin();
+  auto f = fresh_.cbegin();
+  for (const PartPair& p : candidates_) {
+    if (moved_[p.a] || moved_[p.b]) continue;
+    for (; f != fresh_.cend() && *f < p; ++f) *out++ = *f;
+    *out++ = p;
+  }
+  out = std::copy(f, fresh_.cend(), out);
+  kept_.resize(static_cast<std::size_t>(out - kept_.begin()));
+  std::swap(candidates_, kept_);
   for (const std::int32_t k : moved_list_) moved_[k] = 0;
 }
 
