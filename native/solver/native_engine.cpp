@@ -107,6 +107,10 @@ class NativeEngine final : public Engine {
   PairCache pair_cache_;
   std::vector<PartPair> pairs_;
   std::vector<NarrowManifold> narrow_;    // per pair this step: the narrow phase's result
+  // ... and its point count, apart: a pair without contact (most pairs of fat boxes; nearly
+  // all of the towing case's, whose floes at rest reuse theirs) is known by this byte alone,
+  // its 192-byte slot neither written nor read again (collide_pairs, build_contact_list).
+  std::vector<std::uint8_t> narrow_points_, previous_narrow_points_;
   // Per pair, the edges that separated most at its last test, tried first (sat.hpp): the same
   // manifolds, found sooner (a pair's floes turn little in a step).
   std::vector<SeparationHint> narrow_hint_, previous_hint_;
@@ -450,6 +454,7 @@ void NativeEngine::forget_narrow() {
   any_kept_ = false;
   previous_pairs_.clear();
   previous_narrow_.clear();
+  previous_narrow_points_.clear();
   previous_reach_.clear();
 }
 
@@ -494,6 +499,7 @@ void NativeEngine::collide_pairs(bool redetection) {
   // Narrow phase: each pair into its own slot, blocks of pairs on the pool's threads (a pure
   // function of the pair: the same manifolds on any number of threads).
   resize_with_headroom(narrow_, pairs_.size());  // with room: the pairs set new highs as a pack breathes
+  resize_with_headroom(narrow_points_, pairs_.size());
   // Per pair, its slot at the last narrow phase (both lists sorted): its separation hint
   // carries over, and where both parts were kept in place with the same reaches, its manifold.
   // A redetection's narrow phase follows the step's first one with every part where it was
@@ -528,13 +534,11 @@ void NativeEngine::collide_pairs(bool redetection) {
     std::size_t found = 0;
     for (std::size_t k = begin; k < end; ++k) {
       if (may_reuse && reuse_[k] >= 0) {
-        const NarrowManifold& was = previous_narrow_[static_cast<std::size_t>(reuse_[k])];
+        const auto r = static_cast<std::size_t>(reuse_[k]);
         // A pair without contact is read for its point count alone (most pairs of fat boxes).
-        if (was.point_count == 0)
-          narrow_[k].point_count = 0;
-        else
-          copy_manifold(was, narrow_[k]);
-        found += was.point_count != 0;
+        narrow_points_[k] = previous_narrow_points_[r];
+        if (narrow_points_[k] != 0) copy_manifold(previous_narrow_[r], narrow_[k]);
+        found += narrow_points_[k] != 0;
         continue;
       }
       const PartPair pair = pairs_[k];
@@ -549,6 +553,7 @@ void NativeEngine::collide_pairs(bool redetection) {
       m.friction = contact_.friction;
       m.restitution = contact_.restitution;
       collide_parts(pair, part_reach_[pair.a], part_reach_[pair.b], m, &narrow_hint_[k]);
+      narrow_points_[k] = static_cast<std::uint8_t>(m.point_count);
       found += m.point_count != 0;
     }
     block_contacts_[begin / kPairGrain + 1] = found;
@@ -574,8 +579,8 @@ void NativeEngine::build_contact_list() {
     auto old = static_cast<std::size_t>(find_pair(previous_manifolds_, pairs_[begin]) - previous_manifolds_.begin());
     for (std::size_t k = begin; k < end; ++k) {
       const PartPair pair = pairs_[k];
+      if (narrow_points_[k] == 0) continue;
       const NarrowManifold& found = narrow_[k];  // narrow_ keeps the narrow phase's own result (reuse)
-      if (found.point_count == 0) continue;
       Manifold& m = manifolds_[slot++];
       fill_manifold(found, m);
       // Read from the narrow phase's slot, not the fresh copy: a load from a block just copied
@@ -606,6 +611,7 @@ void NativeEngine::build_contact_list() {
   });
   manifolds_.resize(contacts);
   std::swap(narrow_, previous_narrow_);
+  std::swap(narrow_points_, previous_narrow_points_);
   std::swap(narrow_hint_, previous_hint_);
   reserve_with_headroom(previous_pairs_, pairs_.size());
   previous_pairs_.assign(pairs_.begin(), pairs_.end());
