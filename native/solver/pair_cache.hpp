@@ -54,7 +54,7 @@ class PairCache {
   std::vector<std::uint8_t> left_;      // left its fat box this step
   std::vector<std::vector<PartPair>> overlapping_;  // per block of candidates: room for all, the pairs it found first
   std::vector<std::size_t> overlapping_count_;      // ... and how many
-  std::vector<PartPair> candidates_, kept_, fresh_;  // kept_: the spare list refresh() merges into
+  std::vector<PartPair> candidates_, spare_, fresh_;  // spare_: the list refresh() merges into
   std::vector<std::int32_t> hits_;
   std::int64_t rebuilds_ = 0;
   std::int64_t refreshed_ = 0;
