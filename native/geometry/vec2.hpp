@@ -69,6 +69,11 @@ struct Aabb {
   constexpr bool overlaps(const Aabb& o) const {
     return lo.x <= o.hi.x && o.lo.x <= hi.x && lo.y <= o.hi.y && o.lo.y <= hi.y;
   }
+  /// overlaps() with all four comparisons made (no short-circuit), the same answer: for a loop
+  /// that counts overlaps without a branch on the data (PairCache::find_pairs).
+  constexpr bool overlaps_unbranched(const Aabb& o) const {
+    return (lo.x <= o.hi.x) & (o.lo.x <= hi.x) & (lo.y <= o.hi.y) & (o.lo.y <= hi.y);
+  }
 };
 
 }  // namespace floedem
