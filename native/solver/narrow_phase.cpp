@@ -175,9 +175,10 @@ template <class M>
   }
 }
 
-// collide_into built for each LaneIsa (geometry/lane_isa.hpp): the same SSE2 lanes and scalar
-// operations, VEX-encoded with three operands in the AVX builds and with AVX-512's 32 registers
-// in the last, so the same manifold to the bit.
+// collide_into built for each LaneIsa (geometry/lane_isa.hpp): the separating-axis search's
+// four-edge vectors in two SSE2 registers on the baseline and one AVX register in the others
+// (AVX-512's 32 registers in the last), the same IEEE operations lane by lane and the same
+// scalar ones, so the same manifold to the bit.
 template <class M>
 void collide_baseline(const PartGeometry& a, const PartGeometry& b, double margin, double flip_tolerance, M& m,
                       SeparationHint* hint) {

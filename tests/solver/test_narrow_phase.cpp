@@ -242,7 +242,8 @@ TEST_CASE("narrow phase: a pair's separation hint gives the manifold found witho
     for (const auto& [p, q] : {std::pair{va, vb}, std::pair{vb, va}}) {
       const FaceSeparation plain = max_face_separation(p, q);
       const FaceSeparation cut = max_face_separation(p, q, margin);
-      // 3 to 9 corners: every count of edges in the lanes' last group of four, ties included.
+      // 3 to 9 corners: one pass of one or two vectors, and a second pass at 9; every count of
+      // edges in a vector (the lanes past the last repeat edge 0), ties included.
       const FaceSeparation lanes = max_face_separation_lanes(p, q);
       REQUIRE(lanes.edge == plain.edge);
       REQUIRE(bits(lanes.separation) == bits(plain.separation));
