@@ -75,10 +75,4 @@ bool PartSet::place(std::span<const Vec2> position, std::span<const Rot> rotatio
   return any_kept.load(std::memory_order_relaxed);
 }
 
-PartGeometry PartSet::geometry(std::int32_t k, Vec2 position, Rot rotation) const {
-  const std::int32_t first = first_[k];
-  return PartGeometry{ConvexView{&world_vertices_[first], &world_normals_[first], first_[k + 1] - first},
-                      &local_vertices_[first], &local_normals_[first], Transform{position, rotation}};
-}
-
 }  // namespace floedem

@@ -23,7 +23,14 @@ class PartSet {
   /// Per part: 1 where the last place() kept the part's placement (its body did not move).
   std::span<const std::uint8_t> kept() const { return kept_; }
 
-  PartGeometry geometry(std::int32_t part, Vec2 position, Rot rotation) const;
+  /// Inline: the narrow phase asks for two a pair. Out of line, the call and the copy of its
+  /// result were 0.8 % of the 16k field's step (perf); inline, the narrow phase 0.777 -> 0.755
+  /// of the contact solve (floedem bench --stages, four runs each, alternating).
+  PartGeometry geometry(std::int32_t part, Vec2 position, Rot rotation) const {
+    const std::int32_t first = first_[part];
+    return PartGeometry{ConvexView{&world_vertices_[first], &world_normals_[first], first_[part + 1] - first},
+                        &local_vertices_[first], &local_normals_[first], Transform{position, rotation}};
+  }
   std::span<const std::int32_t> body() const { return body_; }
   /// A body's parts are parts first_part(b) to first_part(b + 1) - 1 (parts are in body order).
   std::int32_t first_part(std::int32_t body) const { return first_part_[body]; }
