@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <utility>
 
 #include "geometry/lanes4.hpp"
 #include "geometry/vec2.hpp"

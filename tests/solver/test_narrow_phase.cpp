@@ -183,7 +183,7 @@ TEST_CASE("narrow phase: the separating axes' shortcuts give the full search's e
     const FaceSeparation full = brute(va, vb), fast = max_face_separation(va, vb);
     REQUIRE(fast.edge == full.edge);
     REQUIRE(fast.separation == full.separation);
-    // The lanes' search (no shortcut, four edges at once): the same, to the bit.
+    // The lanes' search (no shortcut, four edges to a vector, eight to a pass): the same, to the bit.
     const FaceSeparation lanes = max_face_separation_lanes(va, vb);
     REQUIRE(lanes.edge == full.edge);
     REQUIRE(std::bit_cast<std::uint64_t>(lanes.separation) == std::bit_cast<std::uint64_t>(full.separation));
