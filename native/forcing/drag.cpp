@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <cmath>
 #include <cstring>
 #if defined(__SSE2__)
@@ -323,12 +324,6 @@ namespace {
 using namespace lanes4;
 constexpr int kQuad = 4;
 static_assert(sizeof(v4d) == sizeof(double) * kQuad);
-// Correctly rounded per lane, as std::sqrt: two SSE2 square roots, split and joined in
-// registers (through memory, the 32-byte load of two 16-byte stores waits for both).
-FLOEDEM_LANES v4d sqrt4(v4d x) {
-  const Pair lo = sqrt_of(__builtin_shufflevector(x, x, 0, 1)), hi = sqrt_of(__builtin_shufflevector(x, x, 2, 3));
-  return __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
-}
 
 // The slots of a few edges or triangles on, asked for ahead of their loads: in the 16k field's
 // step a drag term's slots (about 5 MB) come back from memory each step, after the rest of the
@@ -509,11 +504,7 @@ void DistributedDrag::pack_lanes() const {
   for (std::size_t i = 0; i < entries_.size(); ++i)
     if (entries_[i].slab_count == 1) single.push_back(static_cast<std::uint32_t>(i));
   auto points = [&](std::uint32_t i) { return slabs_[entries_[i].first_slab].count; };
-  constexpr std::size_t kWindow = 64;
-  for (std::size_t w = 0; w < single.size(); w += kWindow)
-    std::stable_sort(single.begin() + static_cast<std::ptrdiff_t>(w),
-                     single.begin() + static_cast<std::ptrdiff_t>(std::min(single.size(), w + kWindow)),
-                     [&](std::uint32_t a, std::uint32_t b) { return points(a) < points(b); });
+  sort_in_lane_windows(single, points);
   for (std::size_t k = 0; k < single.size(); k += kLanes) {
     LaneGroup g;
     lane_moments_.resize(lane_moments_.size() + kLanes);
@@ -558,6 +549,7 @@ void DistributedDrag::pack_lanes() const {
     groups_.push_back(g);
   }
   group_listed_.assign(groups_.size(), 0);
+  group_shared_.assign(groups_.size(), 0);
   list_unlaned();
 }
 
@@ -598,7 +590,18 @@ void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& 
 }
 
 bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) const {
+  return add_rate_bound_impl(s, sums, nullptr);
+}
+
+void DistributedDrag::add_rate_bound_leaving(const BodyStatesView& s, ForceSums& sums,
+                                             const std::vector<std::uint8_t>& shared) const {
+  add_rate_bound_impl(s, sums, &shared);
+}
+
+bool DistributedDrag::add_rate_bound_impl(const BodyStatesView& s, ForceSums& sums,
+                                          const std::vector<std::uint8_t>* shared) const {
   if (!lanes_packed_) pack_lanes();
+  assert(shared == nullptr || lanes_direct(sums));  // DragPass asks lanes_direct first
   if (!lanes_direct(sums)) {
     for_entries(sums, 2048, [&](std::size_t i) { add_entry_bound(i, s, sums); });
     return true;
@@ -612,9 +615,11 @@ bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) c
   });
   thread_pool().for_blocks(groups_.size(), 512, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
+      if (shared != nullptr && group_shared_[k] != 0) continue;  // every lane the pass's
       const LaneGroup& g = groups_[k];
       for (std::uint32_t l = 0; l < g.lanes; ++l) {
         const std::uint32_t body = g.body[l];
+        if (shared != nullptr && (*shared)[body] != 0) continue;  // the pass's
         const Vec2 v = s.velocity[body];
         const double w = s.angular_velocity[body];
         if (lane_adds_nothing(g, l, v, w)) continue;
@@ -623,20 +628,6 @@ bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) c
     }
   });
   return true;
-}
-
-void DistributedDrag::add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& m, Vec2 flow, Vec2 v,
-                                     double w) const {
-  constexpr double kRow = 1.0 + 1.4142135623730951;  // add_entry_bound says why
-  if (settings_.reference_speed > 0.0) {
-    b[0] += settings_.reference_speed * m[0];
-    b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
-    return;
-  }
-  const double du = length(flow - v);
-  const double spin = settings_.rotational ? std::abs(w) : 0.0;
-  b[0] += kRow * (du * m[0] + spin * m[1]);
-  b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
 }
 
 void DistributedDrag::add_entry_bound(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {
@@ -680,7 +671,13 @@ bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
   return true;
 }
 
-void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) const {
+void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) const { add_impl(s, sums, nullptr); }
+
+void DistributedDrag::add_leaving(const BodyStatesView& s, ForceSums& sums, const std::vector<std::uint8_t>& shared) const {
+  add_impl(s, sums, &shared);
+}
+
+void DistributedDrag::add_impl(const BodyStatesView& s, ForceSums& sums, const std::vector<std::uint8_t>* shared) const {
   // Entries are bodies, one each: blocks of them on the pool's threads write distinct bodies,
   // each in the same order as one thread would, so the sums do not depend on the threads.
   // The floes that take the lean path are left to the lanes (add_entry marks them), which then
@@ -690,6 +687,7 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
   // them (the floe adds something and needs no Jacobian).
   if (!lanes_packed_) pack_lanes();
   const bool direct = lanes_direct(sums);
+  assert(shared == nullptr || direct);  // DragPass::add asks lanes_direct first
   std::atomic<bool> any_jacobian{false};
   auto entry = [&](std::size_t i) {
     if (add_entry(i, s, sums) && !any_jacobian.load(std::memory_order_relaxed))
@@ -720,6 +718,7 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
   const std::size_t group_count = direct ? groups_.size() : groups_to_add_.size();
   thread_pool().for_blocks(group_count, 128, [&](std::size_t begin, std::size_t end) {
     for (std::size_t n = begin; n < end; ++n) {
+      if (shared != nullptr && group_shared_[n] != 0) continue;  // every lane the pass's (direct)
       const LaneGroup& g = groups_[direct ? n : groups_to_add_[n]];
       unsigned mask = 0;
       for (std::uint32_t l = 0; l < g.lanes; ++l) {
@@ -730,6 +729,7 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
           // the flow without spin (adds_nothing), the lanes without the Jacobian, else
           // add_entry's own path.
           const std::uint32_t body = g.body[l];
+          if (shared != nullptr && (*shared)[body] != 0) continue;  // the pass adds it, either way
           const bool adds = !lane_adds_nothing(g, l, s.velocity[body], s.angular_velocity[body]);
           in = adds && sums.jacobian[body] == 0;
           if (adds && !in) entry(i);

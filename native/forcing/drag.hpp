@@ -9,7 +9,9 @@
 // Integrating both over the polygon with the local velocity gives the rotational damping torque.
 // Edges: 2-point Gauss rule; area: centroid fan of signed triangles, 3-point edge-midpoint rule
 // (exact for quadratic integrands, hence exact in a uniform flow).
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "forcing/force_term.hpp"
@@ -65,11 +67,20 @@ class DistributedDrag final : public ForceTerm {
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return name_; }
   void add(const BodyStatesView& state, double time, ForceSums& sums) const override;
+  /// add, leaving to a DragPass the bodies it shares (shared[body] != 0: Q alone or with the
+  /// Jacobian, drag_pass.hpp); only on a step that takes the lanes directly (lanes_direct).
+  void add_leaving(const BodyStatesView& state, ForceSums& sums, const std::vector<std::uint8_t>& shared) const;
   bool add_rate_bound(const BodyStatesView& state, ForceSums& sums) const override;
+  /// add_rate_bound, leaving the bodies a DragPass shares to it (as add_leaving).
+  void add_rate_bound_leaving(const BodyStatesView& state, ForceSums& sums, const std::vector<std::uint8_t>& shared) const;
   bool reads_stirred() const override { return calm_; }
   bool idle_at_rest() const override { return calm_; }
 
  private:
+  friend class DragPass;  // reads the packed points and the lanes' choice (drag_pass.hpp)
+  /// add's body; `shared`: the bodies a DragPass adds (nullptr: none).
+  void add_impl(const BodyStatesView& state, ForceSums& sums, const std::vector<std::uint8_t>* shared) const;
+  bool add_rate_bound_impl(const BodyStatesView& state, ForceSums& sums, const std::vector<std::uint8_t>* shared) const;
   // Packed quadrature, read every step: the same points, weights and order as edge_points /
   // area_points with add_form_drag / add_skin_drag (the same sums to the bit, tested), with
   // each slab's scale and coefficient folded into its points (weight = c s l / 2 for an edge
@@ -106,8 +117,19 @@ class DistributedDrag final : public ForceTerm {
   bool add_entry(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   void add_entry_bound(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   /// One slab's share of the rate bound (add_entry_bound's per-slab sum).
-  void add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& moments, Vec2 flow, Vec2 v,
-                      double w) const;
+  /// Inline: DragPass calls it for each shared floe and term (drag_pass.cpp).
+  void add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& m, Vec2 flow, Vec2 v, double w) const {
+    constexpr double kRow = 1.0 + 1.4142135623730951;  // add_entry_bound says why (drag.cpp)
+    if (settings_.reference_speed > 0.0) {
+      b[0] += settings_.reference_speed * m[0];
+      b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
+      return;
+    }
+    const double du = length(flow - v);
+    const double spin = settings_.rotational ? std::abs(w) : 0.0;
+    b[0] += kRow * (du * m[0] + spin * m[1]);
+    b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
+  }
   /// Calls f(i) for each entry that may add something: every entry, or in still water and air
   /// (calm_) only those of the bodies that move (ForceSums::stirred), in blocks of `grain` on
   /// the pool's threads.
@@ -176,6 +198,8 @@ class DistributedDrag final : public ForceTerm {
   mutable std::vector<std::uint8_t> group_listed_;
   mutable std::vector<std::uint32_t> groups_to_add_;
   mutable std::vector<std::uint32_t> unlaned_;          // the entries without one, in order
+  // Per group: every lane's body is one a DragPass adds (set by the pass; add_leaving skips it).
+  mutable std::vector<std::uint8_t> group_shared_;
   /// A moving flow (not calm_), or still water or air with a quarter of the entries' bodies
   /// or more moving (a drifting field's air drag): the lanes' floes are taken straight from
   /// the groups (rate bound and drag), and add_entry / add_entry_bound visit the other entries
@@ -186,6 +210,18 @@ class DistributedDrag final : public ForceTerm {
     return lanes_packed_ && (!calm_ || 4 * sums.stirred.size() >= entries_.size());
   }
 };
+
+/// Sorts ids by key(id) within consecutive windows of 64, in place: ids near in the list (bodies
+/// near in memory) stay near, and the four floes of a lane group end about together (the
+/// terms' lanes and DragPass's groups).
+template <class Key>
+void sort_in_lane_windows(std::vector<std::uint32_t>& ids, Key key) {
+  constexpr std::size_t kWindow = 64;
+  for (std::size_t w = 0; w < ids.size(); w += kWindow)
+    std::stable_sort(ids.begin() + static_cast<std::ptrdiff_t>(w),
+                     ids.begin() + static_cast<std::ptrdiff_t>(std::min(ids.size(), w + kWindow)),
+                     [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+}
 
 /// The term, or nullptr when no body needs it.
 inline std::unique_ptr<ForceTerm> if_used(std::unique_ptr<DistributedDrag> term) {

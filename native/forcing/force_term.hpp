@@ -125,12 +125,21 @@ class ForceTerm {
 /// Builds the term for a scene, or returns nullptr when the scene does not use it.
 using ForceTermBuilder = std::unique_ptr<ForceTerm> (*)(const Scene&);
 
+class DragPass;
+
 /// The terms a scene uses, evaluated together each step.
 class Forcing {
  public:
-  explicit Forcing(const Scene& scene);
+  /// `share_drag_pass`: the drag terms take their floes in one pass (drag_pass.hpp; the same
+  /// loads to the bit); false only to test that.
+  explicit Forcing(const Scene& scene, bool share_drag_pass = true);
+  ~Forcing();
+  Forcing(const Forcing&) = delete;
+  Forcing& operator=(const Forcing&) = delete;
   bool empty() const { return terms_.empty() && prescribed_.empty(); }
   std::vector<std::string_view> names() const;
+  /// How many floes the drag terms take in one shared pass (drag_pass.hpp; 0: none).
+  std::size_t drag_pass_floes() const;
   /// Whether its steps after the first work on the moving bodies alone (see moving_only_).
   bool works_on_moving_bodies_only() const { return moving_only_; }
   /// Loads for the step that starts at `time`, or nullptr when the scene has no forcing.
@@ -147,6 +156,10 @@ class Forcing {
   static constexpr double kExplicitLimit = 0.5;
 
   std::vector<std::unique_ptr<ForceTerm>> terms_;
+  /// The run of consecutive drag terms terms_[pass_first_, pass_first_ + pass_count_) that
+  /// shares one pass over the floes (drag_pass.hpp), or nullptr.
+  std::unique_ptr<DragPass> drag_pass_;
+  std::size_t pass_first_ = 0, pass_count_ = 0;
   std::vector<std::size_t> prescribed_;
   const Scene& scene_;
   double dt_;

@@ -22,6 +22,7 @@
 #include <cmath>
 #include <limits>
 
+#include "forcing/drag_pass.hpp"
 #include "forcing/force_term.hpp"
 #include "parallel/thread_pool.hpp"
 
@@ -69,9 +70,30 @@ bool Forcing::stiff(const std::array<double, 9>& d, double mass, double inertia)
   return dt_ * std::max(linear, angular) > kExplicitLimit;
 }
 
-Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
+Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(scene.run.dt) {
   for (const ForceTermBuilder build : kTerms)
     if (auto term = build(scene)) terms_.push_back(std::move(term));
+  // The longest run of consecutive drag terms (the four of a drifting field) shares a pass
+  // over the floes they all act on, where there are any.
+  for (std::size_t k = 0; share_drag_pass && k < terms_.size();) {
+    std::size_t end = k;
+    while (end < terms_.size() && end - k < static_cast<std::size_t>(DragPass::kMaxTerms) &&
+           dynamic_cast<const DistributedDrag*>(terms_[end].get()) != nullptr)
+      ++end;
+    if (end - k >= 2 && end - k > pass_count_) {
+      std::vector<const DistributedDrag*> run;
+      for (std::size_t t = k; t < end; ++t) run.push_back(static_cast<const DistributedDrag*>(terms_[t].get()));
+      auto pass = std::make_unique<DragPass>(std::move(run), [&](std::size_t i) -> const std::vector<Vec2>& {
+        return scene.bodies[i].local_polygon;
+      });
+      if (!pass->empty()) {
+        drag_pass_ = std::move(pass);
+        pass_first_ = k;
+        pass_count_ = end - k;
+      }
+    }
+    k = std::max(end, k + 1);
+  }
   const std::size_t n = scene.bodies.size();
   for (std::size_t i = 0; i < n; ++i)
     if (scene.bodies[i].prescribed) prescribed_.push_back(i);
@@ -125,6 +147,10 @@ Forcing::Forcing(const Scene& scene) : scene_(scene), dt_(scene.run.dt) {
     }
   }
 }
+
+Forcing::~Forcing() = default;
+
+std::size_t Forcing::drag_pass_floes() const { return drag_pass_ ? drag_pass_->floes() : 0; }
 
 std::vector<std::string_view> Forcing::names() const {
   std::vector<std::string_view> out;
@@ -211,7 +237,13 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
   // skip its nine products per quadrature point). The margin covers rounding in the sums.
   if (!sparse) std::fill(sums_.rate_bound.begin(), sums_.rate_bound.end(), std::array<double, 2>{});
   bool bounded = true;
-  for (const auto& t : terms_) bounded = t->add_rate_bound(at, sums_) && bounded;
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    if (drag_pass_ && k == pass_first_ && drag_pass_->add_rate_bound(at, sums_)) {  // the run's terms (always bounded)
+      k += pass_count_ - 1;
+      continue;
+    }
+    bounded = terms_[k]->add_rate_bound(at, sums_) && bounded;
+  }
   auto needs_jacobian = [&](std::size_t i) {
     const BodyHot& h = hot_[i];
     const std::array<double, 2>& b = sums_.rate_bound[i];
@@ -235,7 +267,13 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
   }
   if (sums_.any_rotation) std::fill(sums_.rotation_rate.begin(), sums_.rotation_rate.end(), 0.0);
   sums_.any_jacobian = sums_.any_rotation = false;
-  for (const auto& t : terms_) t->add(at, time, sums_);
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    if (drag_pass_ && k == pass_first_ && drag_pass_->add(at, time, sums_)) {  // the run's terms, in one pass
+      k += pass_count_ - 1;
+      continue;
+    }
+    terms_[k]->add(at, time, sums_);
+  }
 
   const bool first_step = time == 0.0;
   // Per body, independent: blocks on the pool's threads (the same result on any number).

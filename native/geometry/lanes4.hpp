@@ -8,6 +8,11 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#else
+#include <cmath>
+#endif
 
 namespace floedem::lanes4 {
 
@@ -40,5 +45,15 @@ FLOEDEM_LANES v4d abs(v4d x) {
 }
 // std::max(a, b) per lane: (a < b) ? b : a.
 FLOEDEM_LANES v4d max(v4d a, v4d b) { return select((v4m)(a < b), b, a); }
+// Correctly rounded per lane, as std::sqrt: two SSE2 square roots, split and joined in
+// registers (through memory, the 32-byte load of two 16-byte stores waits for both).
+FLOEDEM_LANES v4d sqrt4(v4d x) {
+#if defined(__SSE2__)
+  const v2d lo = _mm_sqrt_pd(__builtin_shufflevector(x, x, 0, 1)), hi = _mm_sqrt_pd(__builtin_shufflevector(x, x, 2, 3));
+  return __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
+#else
+  return v4d{std::sqrt(x[0]), std::sqrt(x[1]), std::sqrt(x[2]), std::sqrt(x[3])};
+#endif
+}
 
 }  // namespace floedem::lanes4

@@ -11,6 +11,7 @@
 #include "engine/registry.hpp"
 #include "field/field_generator.hpp"
 #include "forcing/drag.hpp"
+#include "forcing/drag_pass.hpp"
 #include "forcing/force_term.hpp"
 #include "geometry/polygon.hpp"
 #include "run/stepper.hpp"
@@ -107,6 +108,17 @@ BENCHMARK(BM_StepFullEnvironment)->Arg(1)->Arg(1000)->Unit(benchmark::kMicroseco
 /// lists made once per floe (as the terms held them before they were packed). Second: N, 1 000
 /// (the points in L2) or 16 000 (the speed benchmark's field: about 20 MB of points, streamed
 /// from L3 or memory each step, as in the field's step).
+/// The sums of n floes of a field before the drag terms add: never stiff (Q alone).
+ForceSums floe_sums(std::size_t n) {
+  ForceSums sums;
+  sums.q.assign(n, {});
+  sums.dq.assign(n, {});
+  sums.rotation_rate.assign(n, 0.0);
+  sums.jacobian.assign(n, 0);
+  sums.rate_bound.assign(n, {});
+  return sums;
+}
+
 void BM_DragQuadrature(benchmark::State& state) {
   const bool packed = state.range(0) != 0;
   const auto n = static_cast<int>(state.range(1));
@@ -118,12 +130,7 @@ void BM_DragQuadrature(benchmark::State& state) {
   std::vector<std::vector<AreaPoint>> points;
   BodyStates s;
   s.resize(n);
-  ForceSums sums;
-  sums.q.assign(n, {});
-  sums.dq.assign(n, {});
-  sums.rotation_rate.assign(n, 0.0);
-  sums.jacobian.assign(n, 0);  // floes of a field: never stiff, Q alone
-  sums.rate_bound.assign(n, {});
+  ForceSums sums = floe_sums(n);
   const Vec2 current{0.3, 0.1};
   for (int i = 0; i < n; ++i) {
     const int corners = 5 + i % 5;
@@ -164,6 +171,60 @@ void BM_DragQuadrature(benchmark::State& state) {
       benchmark::Counter(n, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_DragQuadrature)->Args({0, 1000})->Args({1, 1000})->Args({1, 16000})->Unit(benchmark::kMicrosecond);
+
+/// A drifting floe's four drag terms (water form and skin in the current, air form and skin in
+/// the wind), rate bound and sums: the terms one after the other (0) or in one shared pass (1,
+/// forcing/drag_pass.hpp; the same sums to the bit). In cache at 1 000 floes; at 16 000 the
+/// terms' packed points (about 19 MB) no longer fit, as in the speed benchmark's step.
+void BM_DragTerms(benchmark::State& state) {
+  const bool shared = state.range(0) != 0;
+  const auto n = static_cast<std::size_t>(state.range(1));
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  EnvironmentSpec env;
+  using Kind = DistributedDrag::Kind;
+  DistributedDrag water_form("water_form", Kind::form, env), water_skin("water_skin", Kind::skin, env),
+      air_form("air_form", Kind::form, env), air_skin("air_skin", Kind::skin, env);
+  std::vector<std::vector<Vec2>> polys(n);
+  BodyStates s;
+  s.resize(n);
+  ForceSums sums = floe_sums(n);
+  const Vec2 current{0.3, 0.1}, wind{6.0, 4.0};
+  for (std::size_t i = 0; i < n; ++i) {
+    const int corners = 5 + static_cast<int>(i % 5);
+    const double size = 2.5 + 12.5 * (1.0 + u(rng)) / 2.0;
+    for (int k = 0; k < corners; ++k) {
+      const double a = 2.0 * M_PI * (k + 0.3 * u(rng)) / corners;
+      polys[i].push_back({size * std::cos(a), size * std::sin(a)});
+    }
+    const Vec2 c = area_moments(polys[i]).centroid;
+    for (Vec2& p : polys[i]) p = p - c;
+    water_form.add_body(i, polys[i], {{0.5 * 1025.0 * 0.6 * 0.9, 1.0, current}});
+    water_skin.add_body(i, polys[i], {{1025.0 * 0.0055, 1.0, current}});
+    air_form.add_body(i, polys[i], {{0.5 * 1.3 * 0.4 * 0.1, 1.0, wind}});
+    air_skin.add_body(i, polys[i], {{1.3 * 0.0025, 1.0, wind}});
+    s.velocity[i] = {0.2 + 0.1 * u(rng), 0.1 * u(rng)};
+    s.angular_velocity[i] = 0.01 * u(rng);
+    sums.rotation.push_back(Rot::from_angle(u(rng)));
+    sums.stirred.push_back(static_cast<std::int32_t>(i));
+  }
+  const std::vector<const DistributedDrag*> terms{&water_form, &water_skin, &air_form, &air_skin};
+  const DragPass pass(terms, [&](std::size_t i) -> const std::vector<Vec2>& { return polys[i]; });
+  if (pass.floes() != n) state.SkipWithError("the pass did not take every floe");
+  for (auto _ : state) {
+    if (shared) {
+      pass.add_rate_bound(s, sums);
+      pass.add(s, 0.0, sums);
+    } else {
+      for (const DistributedDrag* t : terms) t->add_rate_bound(s, sums);
+      for (const DistributedDrag* t : terms) t->add(s, 0.0, sums);
+    }
+    benchmark::DoNotOptimize(sums.q.data());
+  }
+  state.counters["ns_per_floe"] =
+      benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_DragTerms)->Args({0, 1000})->Args({1, 1000})->Args({0, 16000})->Args({1, 16000})->Unit(benchmark::kMicrosecond);
 
 /// Field generation (issue 4's targets: 1e4 floes under 2 s, 1e5 under 20 s on 2 cores):
 /// alpha 2, d 2..50 m, C 0.5, default irregularity; the square domain holds N floes.

@@ -307,12 +307,7 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
           for (std::size_t i = 0; i < n; ++i) {
             const int corners = 3 + static_cast<int>((i * 5) % 7);
             const double size = 2.5 + 14.0 * (1.0 + u(rng));
-            for (int k = 0; k < corners; ++k) {
-              const double a = 2.0 * M_PI * (k + 0.3 * u(rng)) / corners;
-              polys[i].push_back({size * std::cos(a), size * std::sin(a)});
-            }
-            const Vec2 c = area_moments(polys[i]).centroid;
-            for (Vec2& p : polys[i]) p = p - c;
+            polys[i] = test::jittered_polygon(rng, corners, size);
             if (i % 9 == 4) polys[i].insert(polys[i].begin() + 1, polys[i][1]);  // a zero-length edge
             const Vec2 flow = still ? Vec2{} : Vec2{0.5 * u(rng), 0.5 * u(rng)};
             slabs[i].push_back({300.0 * (1.0 + u(rng)), 0.6 + 0.3 * u(rng), flow});
