@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cassert>
 #include <cmath>
 #include <cstring>
 #if defined(__SSE2__)
@@ -115,6 +114,18 @@ void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double sc
 
 DistributedDrag::DistributedDrag(std::string_view name, Kind kind, const EnvironmentSpec& environment)
     : name_(name), kind_(kind), settings_{environment.rotational_damping, environment.drag_reference_speed} {}
+
+void DistributedDrag::leave_to_pass(const std::vector<std::uint8_t>& shared) {
+  passed_.assign(entries_.size(), 0);
+  for (std::size_t i = 0; i < entries_.size(); ++i)
+    passed_[i] = entries_[i].body < shared.size() && shared[entries_[i].body] != 0 ? 1 : 0;
+  // The lanes are packed again, without them, at the next add (their slots are the pass's now).
+  lanes_packed_ = false;
+  groups_ = {};
+  form_lanes_ = {};
+  skin_lanes_ = {};
+  lane_moments_ = {};
+}
 
 void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_polygon, std::vector<DragSlab> slabs) {
   const std::vector<EdgePoint> edges = kind_ == Kind::form ? edge_points(local_polygon) : std::vector<EdgePoint>{};
@@ -492,7 +503,7 @@ void DistributedDrag::pack_lanes() const {
   lanes_packed_ = true;
   auto list_unlaned = [&] {
     for (std::size_t i = 0; i < entries_.size(); ++i)
-      if (laned_[i] == 0) unlaned_.push_back(static_cast<std::uint32_t>(i));
+      if (laned_[i] == 0 && !passed(i)) unlaned_.push_back(static_cast<std::uint32_t>(i));
   };
   if (settings_.reference_speed > 0.0) {  // linearised drag never takes the lean path
     list_unlaned();
@@ -502,7 +513,7 @@ void DistributedDrag::pack_lanes() const {
   // each window sorted by its entries' points so that a group's lanes end about together.
   std::vector<std::uint32_t> single;
   for (std::size_t i = 0; i < entries_.size(); ++i)
-    if (entries_[i].slab_count == 1) single.push_back(static_cast<std::uint32_t>(i));
+    if (entries_[i].slab_count == 1 && !passed(i)) single.push_back(static_cast<std::uint32_t>(i));
   auto points = [&](std::uint32_t i) { return slabs_[entries_[i].first_slab].count; };
   sort_in_lane_windows(single, points);
   for (std::size_t k = 0; k < single.size(); k += kLanes) {
@@ -549,7 +560,6 @@ void DistributedDrag::pack_lanes() const {
     groups_.push_back(g);
   }
   group_listed_.assign(groups_.size(), 0);
-  group_shared_.assign(groups_.size(), 0);
   list_unlaned();
 }
 
@@ -575,7 +585,8 @@ template <class F>
 void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& f) const {
   if (!calm_) {
     thread_pool().for_blocks(entries_.size(), grain, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) f(i);
+      for (std::size_t i = begin; i < end; ++i)
+        if (!passed(i)) f(i);
     });
     return;
   }
@@ -584,24 +595,15 @@ void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& 
   thread_pool().for_blocks(sums.stirred.size(), grain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const auto body = static_cast<std::size_t>(sums.stirred[k]);
-      if (body < entry_of_body_.size() && entry_of_body_[body] >= 0) f(static_cast<std::size_t>(entry_of_body_[body]));
+      if (body >= entry_of_body_.size() || entry_of_body_[body] < 0) continue;
+      const auto i = static_cast<std::size_t>(entry_of_body_[body]);
+      if (!passed(i)) f(i);
     }
   });
 }
 
 bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) const {
-  return add_rate_bound_impl(s, sums, nullptr);
-}
-
-void DistributedDrag::add_rate_bound_leaving(const BodyStatesView& s, ForceSums& sums,
-                                             const std::vector<std::uint8_t>& shared) const {
-  add_rate_bound_impl(s, sums, &shared);
-}
-
-bool DistributedDrag::add_rate_bound_impl(const BodyStatesView& s, ForceSums& sums,
-                                          const std::vector<std::uint8_t>* shared) const {
   if (!lanes_packed_) pack_lanes();
-  assert(shared == nullptr || lanes_direct(sums));  // DragPass asks lanes_direct first
   if (!lanes_direct(sums)) {
     for_entries(sums, 2048, [&](std::size_t i) { add_entry_bound(i, s, sums); });
     return true;
@@ -615,11 +617,9 @@ bool DistributedDrag::add_rate_bound_impl(const BodyStatesView& s, ForceSums& su
   });
   thread_pool().for_blocks(groups_.size(), 512, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
-      if (shared != nullptr && group_shared_[k] != 0) continue;  // every lane the pass's
       const LaneGroup& g = groups_[k];
       for (std::uint32_t l = 0; l < g.lanes; ++l) {
         const std::uint32_t body = g.body[l];
-        if (shared != nullptr && (*shared)[body] != 0) continue;  // the pass's
         const Vec2 v = s.velocity[body];
         const double w = s.angular_velocity[body];
         if (lane_adds_nothing(g, l, v, w)) continue;
@@ -671,13 +671,7 @@ bool DistributedDrag::adds_nothing(std::size_t i, Vec2 v, double w) const {
   return true;
 }
 
-void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) const { add_impl(s, sums, nullptr); }
-
-void DistributedDrag::add_leaving(const BodyStatesView& s, ForceSums& sums, const std::vector<std::uint8_t>& shared) const {
-  add_impl(s, sums, &shared);
-}
-
-void DistributedDrag::add_impl(const BodyStatesView& s, ForceSums& sums, const std::vector<std::uint8_t>* shared) const {
+void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) const {
   // Entries are bodies, one each: blocks of them on the pool's threads write distinct bodies,
   // each in the same order as one thread would, so the sums do not depend on the threads.
   // The floes that take the lean path are left to the lanes (add_entry marks them), which then
@@ -687,7 +681,6 @@ void DistributedDrag::add_impl(const BodyStatesView& s, ForceSums& sums, const s
   // them (the floe adds something and needs no Jacobian).
   if (!lanes_packed_) pack_lanes();
   const bool direct = lanes_direct(sums);
-  assert(shared == nullptr || direct);  // DragPass::add asks lanes_direct first
   std::atomic<bool> any_jacobian{false};
   auto entry = [&](std::size_t i) {
     if (add_entry(i, s, sums) && !any_jacobian.load(std::memory_order_relaxed))
@@ -718,7 +711,6 @@ void DistributedDrag::add_impl(const BodyStatesView& s, ForceSums& sums, const s
   const std::size_t group_count = direct ? groups_.size() : groups_to_add_.size();
   thread_pool().for_blocks(group_count, 128, [&](std::size_t begin, std::size_t end) {
     for (std::size_t n = begin; n < end; ++n) {
-      if (shared != nullptr && group_shared_[n] != 0) continue;  // every lane the pass's (direct)
       const LaneGroup& g = groups_[direct ? n : groups_to_add_[n]];
       unsigned mask = 0;
       for (std::uint32_t l = 0; l < g.lanes; ++l) {
@@ -729,7 +721,6 @@ void DistributedDrag::add_impl(const BodyStatesView& s, ForceSums& sums, const s
           // the flow without spin (adds_nothing), the lanes without the Jacobian, else
           // add_entry's own path.
           const std::uint32_t body = g.body[l];
-          if (shared != nullptr && (*shared)[body] != 0) continue;  // the pass adds it, either way
           const bool adds = !lane_adds_nothing(g, l, s.velocity[body], s.angular_velocity[body]);
           in = adds && sums.jacobian[body] == 0;
           if (adds && !in) entry(i);

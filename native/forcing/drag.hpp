@@ -67,20 +67,17 @@ class DistributedDrag final : public ForceTerm {
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return name_; }
   void add(const BodyStatesView& state, double time, ForceSums& sums) const override;
-  /// add, leaving to a DragPass the bodies it shares (shared[body] != 0: Q alone or with the
-  /// Jacobian, drag_pass.hpp); only on a step that takes the lanes directly (lanes_direct).
-  void add_leaving(const BodyStatesView& state, ForceSums& sums, const std::vector<std::uint8_t>& shared) const;
   bool add_rate_bound(const BodyStatesView& state, ForceSums& sums) const override;
-  /// add_rate_bound, leaving the bodies a DragPass shares to it (as add_leaving).
-  void add_rate_bound_leaving(const BodyStatesView& state, ForceSums& sums, const std::vector<std::uint8_t>& shared) const;
   bool reads_stirred() const override { return calm_; }
   bool idle_at_rest() const override { return calm_; }
 
  private:
-  friend class DragPass;  // reads the packed points and the lanes' choice (drag_pass.hpp)
-  /// add's body; `shared`: the bodies a DragPass adds (nullptr: none).
-  void add_impl(const BodyStatesView& state, ForceSums& sums, const std::vector<std::uint8_t>* shared) const;
-  bool add_rate_bound_impl(const BodyStatesView& state, ForceSums& sums, const std::vector<std::uint8_t>* shared) const;
+  friend class DragPass;  // reads the packed points, calls add_entry and add_slab_bound (drag_pass.hpp)
+  /// From here on, add and add_rate_bound leave the bodies with shared[body] != 0 to a DragPass,
+  /// which adds them (and this term's lanes no longer hold them).
+  void leave_to_pass(const std::vector<std::uint8_t>& shared);
+  bool passed(std::size_t i) const { return !passed_.empty() && passed_[i] != 0; }
+  std::vector<std::uint8_t> passed_;  // per entry: left to a DragPass
   // Packed quadrature, read every step: the same points, weights and order as edge_points /
   // area_points with add_form_drag / add_skin_drag (the same sums to the bit, tested), with
   // each slab's scale and coefficient folded into its points (weight = c s l / 2 for an edge
@@ -198,8 +195,6 @@ class DistributedDrag final : public ForceTerm {
   mutable std::vector<std::uint8_t> group_listed_;
   mutable std::vector<std::uint32_t> groups_to_add_;
   mutable std::vector<std::uint32_t> unlaned_;          // the entries without one, in order
-  // Per group: every lane's body is one a DragPass adds (set by the pass; add_leaving skips it).
-  mutable std::vector<std::uint8_t> group_shared_;
   /// A moving flow (not calm_), or still water or air with a quarter of the entries' bodies
   /// or more moving (a drifting field's air drag): the lanes' floes are taken straight from
   /// the groups (rate bound and drag), and add_entry / add_entry_bound visit the other entries

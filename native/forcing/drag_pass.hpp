@@ -17,10 +17,13 @@
 // outline, facing away from the flow, or the body at rest in that term's flow) adds -0, and
 // x + (-0) = x for every x. Built only for floes that every term of the run holds in one slab
 // of scale 1 with quadratic drag; the pass checks, body by body, that the points it forms are
-// the terms' packed points to the bit, and leaves any other body to the terms.
+// the terms' packed points to the bit, and leaves any other body to the terms. A shared floe
+// that needs the Jacobian takes each term's own path (DistributedDrag::add_entry), in term
+// order; in still water and air only the groups with a moving floe are visited.
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "forcing/drag.hpp"
@@ -32,20 +35,18 @@ class DragPass {
   static constexpr int kMaxTerms = 4;
   static constexpr std::uint32_t kMaxCorners = 24;  ///< larger outlines are left to the terms
 
-  /// `terms`: consecutive terms of Forcing's order (at most kMaxTerms); `polygon` gives a
-  /// body's waterline polygon as the terms were given it (BodySpec::local_polygon).
-  DragPass(std::vector<const DistributedDrag*> terms, const std::function<const std::vector<Vec2>&(std::size_t)>& polygon);
-  /// No floe is shared: the terms add alone.
-  bool empty() const { return groups_.empty(); }
+  /// `terms`: consecutive terms of Forcing's order (at most kMaxTerms), every body added; from
+  /// here on they leave the floes the pass takes to it (DistributedDrag::leave_to_pass), so the
+  /// run is added through the pass alone. `polygon` gives a body's waterline polygon as the
+  /// terms were given it (BodySpec::local_polygon).
+  DragPass(const std::vector<DistributedDrag*>& terms, const std::function<const std::vector<Vec2>&(std::size_t)>& polygon);
+  /// How many floes the pass takes (0: the terms keep every body).
   std::size_t floes() const { return floes_; }
-  /// Adds the run's terms as they would add one after the other, the shared floes in one pass.
-  /// Returns false, having added nothing, where a term would not take its lanes directly this
-  /// step (DistributedDrag::lanes_direct: the towing case's field at rest): the caller then
-  /// adds the terms one by one.
-  bool add(const BodyStatesView& state, double time, ForceSums& sums) const;
-  /// The run's rate bounds (ForceTerm::add_rate_bound), the shared floes' term by term in one
-  /// pass; false, having added nothing, where add would be (the caller then asks the terms).
-  bool add_rate_bound(const BodyStatesView& state, ForceSums& sums) const;
+  /// Adds the run's terms as they would add one after the other: each term its own bodies,
+  /// then the shared floes in one pass.
+  void add(const BodyStatesView& state, double time, ForceSums& sums) const;
+  /// The run's rate bounds (ForceTerm::add_rate_bound), likewise.
+  void add_rate_bound(const BodyStatesView& state, ForceSums& sums) const;
 
   static constexpr int kLanes = 4;
   struct Group {
@@ -80,8 +81,14 @@ class DragPass {
   std::vector<Group> groups_;
   std::vector<Slot> slots_;
   std::vector<Moments> moments_;  // one per group, read in the groups' order
-  std::vector<std::uint8_t> shared_;  // per body: 1 where the pass adds it (DistributedDrag::add_leaving)
+  std::vector<std::uint8_t> shared_;  // per body: 1 where the pass adds it
   std::size_t floes_ = 0;
+  /// The groups to visit this step (drag_pass.cpp).
+  std::span<const std::uint32_t> groups_to_visit(const ForceSums& sums) const;
+  bool calm_ = false;                       // every term's flows are zero (DistributedDrag::calm_)
+  std::vector<std::int32_t> group_of_body_;  // -1: not shared
+  mutable std::vector<std::uint32_t> visit_;
+  mutable std::vector<std::uint8_t> listed_;
 };
 
 }  // namespace floedem

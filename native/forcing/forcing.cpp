@@ -73,26 +73,25 @@ bool Forcing::stiff(const std::array<double, 9>& d, double mass, double inertia)
 Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(scene.run.dt) {
   for (const ForceTermBuilder build : kTerms)
     if (auto term = build(scene)) terms_.push_back(std::move(term));
-  // The longest run of consecutive drag terms (the four of a drifting field) shares a pass
-  // over the floes they all act on, where there are any.
-  for (std::size_t k = 0; share_drag_pass && k < terms_.size();) {
+  // The first run of consecutive drag terms (the four of a drifting field) shares a pass over
+  // the floes they all act on; from then on those terms leave those floes to the pass.
+  for (std::size_t k = 0; share_drag_pass && k < terms_.size(); ++k) {
     std::size_t end = k;
     while (end < terms_.size() && end - k < static_cast<std::size_t>(DragPass::kMaxTerms) &&
-           dynamic_cast<const DistributedDrag*>(terms_[end].get()) != nullptr)
+           dynamic_cast<DistributedDrag*>(terms_[end].get()) != nullptr)
       ++end;
-    if (end - k >= 2 && end - k > pass_count_) {
-      std::vector<const DistributedDrag*> run;
-      for (std::size_t t = k; t < end; ++t) run.push_back(static_cast<const DistributedDrag*>(terms_[t].get()));
-      auto pass = std::make_unique<DragPass>(std::move(run), [&](std::size_t i) -> const std::vector<Vec2>& {
-        return scene.bodies[i].local_polygon;
-      });
-      if (!pass->empty()) {
-        drag_pass_ = std::move(pass);
-        pass_first_ = k;
-        pass_count_ = end - k;
-      }
+    if (end - k < 2) continue;
+    std::vector<DistributedDrag*> run;
+    for (std::size_t t = k; t < end; ++t) run.push_back(static_cast<DistributedDrag*>(terms_[t].get()));
+    auto pass = std::make_unique<DragPass>(run, [&](std::size_t i) -> const std::vector<Vec2>& {
+      return scene.bodies[i].local_polygon;
+    });
+    if (pass->floes() > 0) {  // else no floe was left to it: the terms add alone
+      drag_pass_ = std::move(pass);
+      pass_first_ = k;
+      pass_count_ = end - k;
     }
-    k = std::max(end, k + 1);
+    break;
   }
   const std::size_t n = scene.bodies.size();
   for (std::size_t i = 0; i < n; ++i)
@@ -238,7 +237,8 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
   if (!sparse) std::fill(sums_.rate_bound.begin(), sums_.rate_bound.end(), std::array<double, 2>{});
   bool bounded = true;
   for (std::size_t k = 0; k < terms_.size(); ++k) {
-    if (drag_pass_ && k == pass_first_ && drag_pass_->add_rate_bound(at, sums_)) {  // the run's terms (always bounded)
+    if (drag_pass_ && k == pass_first_) {  // the run's terms (drag: always bounded)
+      drag_pass_->add_rate_bound(at, sums_);
       k += pass_count_ - 1;
       continue;
     }
@@ -268,7 +268,8 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
   if (sums_.any_rotation) std::fill(sums_.rotation_rate.begin(), sums_.rotation_rate.end(), 0.0);
   sums_.any_jacobian = sums_.any_rotation = false;
   for (std::size_t k = 0; k < terms_.size(); ++k) {
-    if (drag_pass_ && k == pass_first_ && drag_pass_->add(at, time, sums_)) {  // the run's terms, in one pass
+    if (drag_pass_ && k == pass_first_) {  // the run's terms, the shared floes in one pass
+      drag_pass_->add(at, time, sums_);
       k += pass_count_ - 1;
       continue;
     }

@@ -33,7 +33,7 @@ TEST_CASE("Coriolis only: the inertial circle closes after 10 periods at dt = 60
   const Vec2 v0{0.3, -0.1};
   std::ostringstream t;
   t.precision(17);
-  t << "[run]\nduration = " << steps * dt << "\ndt = " << dt << "\n[environment]\nlatitude = " << lat << "\n" << kNoDrag
+  t << "[run]\nduration = " << static_cast<double>(steps) * dt << "\ndt = " << dt << "\n[environment]\nlatitude = " << lat << "\n" << kNoDrag
     << floe("a", {100, 200}, 10, v0);
   const Scene s = test::scene_from(t.str());
   auto e = test::native(s);
