@@ -279,8 +279,8 @@ DragPass::DragPass(const std::vector<DistributedDrag*>& terms,
     bodies = std::max(bodies, d.entry_of_body_.size());
   }
   const double g0 = gauss_first(), g1 = gauss_second();
-  // A body the pass can take: one slab of scale 1 in every term's lanes, and each term's packed
-  // points those the pass forms from its corners, to the bit.
+  // A body the pass can take: one slab of scale 1 in every term, and each term's packed points
+  // those the pass forms from its corners, to the bit.
   auto takes = [&](std::size_t body) {
     const std::vector<Vec2>& poly = polygon(body);
     const std::size_t n = poly.size();
