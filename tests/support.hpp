@@ -8,14 +8,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "engine/registry.hpp"
+#include "floe_polygon.hpp"
 #include "forcing/force_term.hpp"
-#include "geometry/polygon.hpp"
 #include "scenario/scenario.hpp"
 
 namespace floedem::test {
@@ -50,20 +49,6 @@ inline Scene scene_from(const std::string& toml, const std::vector<std::string>&
 }
 
 inline std::unique_ptr<Engine> native(const Scene& s) { return make_engine("native", s); }
-
-/// A floe-like polygon about its centroid (the drag tests' floes): corner k at the angle
-/// 2 pi (k + 0.3 u) / corners and distance `size`, u uniform in [-1, 1) drawn from rng.
-inline std::vector<Vec2> jittered_polygon(std::mt19937_64& rng, int corners, double size) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<Vec2> poly;
-  for (int k = 0; k < corners; ++k) {
-    const double a = 2.0 * M_PI * (k + 0.3 * u(rng)) / corners;
-    poly.push_back({size * std::cos(a), size * std::sin(a)});
-  }
-  const Vec2 c = area_moments(poly).centroid;
-  for (Vec2& p : poly) p = p - c;
-  return poly;
-}
 
 /// x component of the contact force on `body` over the engine's last step (its impulses / dt).
 inline double contact_force_x(const Engine& e, int body, double dt) {

@@ -17,7 +17,7 @@ namespace floedem {
 std::vector<EdgePoint> edge_points(const std::vector<Vec2>& poly) {
   std::vector<EdgePoint> out;
   const std::size_t n = poly.size();
-  const double g = 0.5 / std::sqrt(3.0);  // Gauss points at 1/2 -+ 1/(2 sqrt 3)
+  const double g = gauss_offset();  // Gauss points at 1/2 -+ 1/(2 sqrt 3)
   for (std::size_t k = 0; k < n; ++k) {
     const Vec2 a = poly[k], b = poly[(k + 1) % n];
     const double len = length(b - a);
@@ -628,6 +628,20 @@ bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) c
     }
   });
   return true;
+}
+
+void DistributedDrag::add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& m, Vec2 flow, Vec2 v,
+                                     double w) const {
+  constexpr double kRow = 1.0 + 1.4142135623730951;  // add_entry_bound says why
+  if (settings_.reference_speed > 0.0) {
+    b[0] += settings_.reference_speed * m[0];
+    b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
+    return;
+  }
+  const double du = length(flow - v);
+  const double spin = settings_.rotational ? std::abs(w) : 0.0;
+  b[0] += kRow * (du * m[0] + spin * m[1]);
+  b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
 }
 
 void DistributedDrag::add_entry_bound(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {

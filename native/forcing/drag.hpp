@@ -18,6 +18,10 @@
 
 namespace floedem {
 
+/// The 2-point Gauss rule's points on an edge from a to b: a + (1/2 -+ g) (b - a), with
+/// g = 1 / (2 sqrt 3) (edge_points; DragPass forms the same points from the corners).
+inline double gauss_offset() { return 0.5 / std::sqrt(3.0); }
+
 struct EdgePoint {
   Vec2 r;        ///< body frame, from the centroid
   Vec2 normal;   ///< body frame, outward
@@ -72,7 +76,7 @@ class DistributedDrag final : public ForceTerm {
   bool idle_at_rest() const override { return calm_; }
 
  private:
-  friend class DragPass;  // reads the packed points, calls add_entry and add_slab_bound (drag_pass.hpp)
+  friend class DragPass;  // reads the packed points and moments, calls add_entry (drag_pass.hpp)
   /// From here on, add and add_rate_bound leave the bodies with shared[body] != 0 to a DragPass,
   /// which adds them (and this term's lanes no longer hold them).
   void leave_to_pass(const std::vector<std::uint8_t>& shared);
@@ -114,19 +118,8 @@ class DistributedDrag final : public ForceTerm {
   bool add_entry(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   void add_entry_bound(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   /// One slab's share of the rate bound (add_entry_bound's per-slab sum).
-  /// Inline: DragPass calls it for each shared floe and term (drag_pass.cpp).
-  void add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& m, Vec2 flow, Vec2 v, double w) const {
-    constexpr double kRow = 1.0 + 1.4142135623730951;  // add_entry_bound says why (drag.cpp)
-    if (settings_.reference_speed > 0.0) {
-      b[0] += settings_.reference_speed * m[0];
-      b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
-      return;
-    }
-    const double du = length(flow - v);
-    const double spin = settings_.rotational ? std::abs(w) : 0.0;
-    b[0] += kRow * (du * m[0] + spin * m[1]);
-    b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
-  }
+  void add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& moments, Vec2 flow, Vec2 v,
+                      double w) const;
   /// Calls f(i) for each entry that may add something: every entry, or in still water and air
   /// (calm_) only those of the bodies that move (ForceSums::stirred), in blocks of `grain` on
   /// the pool's threads.

@@ -1,10 +1,10 @@
 #include "forcing/drag_pass.hpp"
 
 #include <algorithm>
-#include <span>
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <span>
 
 #include "geometry/lane_isa.hpp"
 #include "geometry/lanes4.hpp"
@@ -17,9 +17,9 @@ using namespace lanes4;
 constexpr int kLanes = DragPass::kLanes;
 constexpr int kMaxTerms = DragPass::kMaxTerms;
 
-// edge_points' Gauss points (drag.cpp): a + (1/2 -+ g) (b - a), g = 1 / (2 sqrt 3).
-double gauss_first() { return 0.5 - 0.5 / std::sqrt(3.0); }
-double gauss_second() { return 0.5 + 0.5 / std::sqrt(3.0); }
+// edge_points' Gauss points (drag.cpp): a + (1/2 -+ g) (b - a), formed as it forms them.
+double gauss_first() { return 0.5 - gauss_offset(); }
+double gauss_second() { return 0.5 + gauss_offset(); }
 
 /// A point's force and moment, held until its term's turn to add (terms after the first).
 struct Held {
@@ -376,17 +376,16 @@ DragPass::DragPass(const std::vector<DistributedDrag*>& terms,
   for (std::size_t k = 0; k < groups_.size(); ++k)
     for (std::uint32_t l = 0; l < groups_[k].lanes; ++l) group_of_body_[groups_[k].body[l]] = static_cast<std::int32_t>(k);
   listed_.assign(groups_.size(), 0);
+  if (!calm_)  // every group, every step (groups_to_visit)
+    for (std::size_t k = 0; k < groups_.size(); ++k) visit_.push_back(static_cast<std::uint32_t>(k));
 }
 
 std::span<const std::uint32_t> DragPass::groups_to_visit(const ForceSums& sums) const {
   // In still water and air (every term calm) a floe at rest adds exactly nothing in any term
   // (DistributedDrag::adds_nothing; the kernels add -0), so only the groups with a moving floe
   // are visited, in group order (the towing case's field: some 300 of 5 000 floes move).
+  if (!calm_) return visit_;  // every group, listed once by the constructor
   visit_.clear();
-  if (!calm_) {
-    for (std::size_t k = 0; k < groups_.size(); ++k) visit_.push_back(static_cast<std::uint32_t>(k));
-    return visit_;
-  }
   for (const std::int32_t body : sums.stirred) {
     const auto b = static_cast<std::size_t>(body);
     if (b >= group_of_body_.size() || group_of_body_[b] < 0) continue;

@@ -87,7 +87,7 @@ class DragPass {
   std::span<const std::uint32_t> groups_to_visit(const ForceSums& sums) const;
   bool calm_ = false;                       // every term's flows are zero (DistributedDrag::calm_)
   std::vector<std::int32_t> group_of_body_;  // -1: not shared
-  mutable std::vector<std::uint32_t> visit_;
+  mutable std::vector<std::uint32_t> visit_;  // a moving flow: every group, fixed
   mutable std::vector<std::uint8_t> listed_;
 };
 

@@ -10,11 +10,11 @@
 #include <string>
 
 #include "engine/registry.hpp"
+#include "floe_polygon.hpp"
 #include "field/field_generator.hpp"
 #include "forcing/drag.hpp"
 #include "forcing/drag_pass.hpp"
 #include "forcing/force_term.hpp"
-#include "geometry/polygon.hpp"
 #include "run/stepper.hpp"
 #include "scenario/scenario.hpp"
 #include "solver/broad_phase.hpp"
@@ -136,13 +136,7 @@ void BM_DragQuadrature(benchmark::State& state) {
   for (int i = 0; i < n; ++i) {
     const int corners = 5 + i % 5;
     const double size = 2.5 + 12.5 * (1.0 + u(rng)) / 2.0;
-    std::vector<Vec2> poly;
-    for (int k = 0; k < corners; ++k) {
-      const double a = 2.0 * M_PI * (k + 0.3 * u(rng)) / corners;
-      poly.push_back({size * std::cos(a), size * std::sin(a)});
-    }
-    const Vec2 c = area_moments(poly).centroid;
-    for (Vec2& p : poly) p = p - c;
+    const std::vector<Vec2> poly = test::jittered_polygon(rng, corners, size);
     form.add_body(static_cast<std::size_t>(i), poly, {{0.5 * 1025.0 * 0.6 * 1.0, 1.0, current}});
     skin.add_body(static_cast<std::size_t>(i), poly, {{1025.0 * 0.0055, 1.0, current}});
     edges.push_back(edge_points(poly));
@@ -194,12 +188,7 @@ void BM_DragTerms(benchmark::State& state) {
   for (std::size_t i = 0; i < n; ++i) {
     const int corners = 5 + static_cast<int>(i % 5);
     const double size = 2.5 + 12.5 * (1.0 + u(rng)) / 2.0;
-    for (int k = 0; k < corners; ++k) {
-      const double a = 2.0 * M_PI * (k + 0.3 * u(rng)) / corners;
-      polys[i].push_back({size * std::cos(a), size * std::sin(a)});
-    }
-    const Vec2 c = area_moments(polys[i]).centroid;
-    for (Vec2& p : polys[i]) p = p - c;
+    polys[i] = test::jittered_polygon(rng, corners, size);
     water_form.add_body(i, polys[i], {{0.5 * 1025.0 * 0.6 * 0.9, 1.0, current}});
     water_skin.add_body(i, polys[i], {{1025.0 * 0.0055, 1.0, current}});
     air_form.add_body(i, polys[i], {{0.5 * 1.3 * 0.4 * 0.1, 1.0, wind}});

@@ -9,7 +9,6 @@
 
 #include "forcing/drag_pass.hpp"
 #include "geometry/lane_isa.hpp"
-#include "geometry/polygon.hpp"
 #include "scenario/scenario.hpp"
 #include "support.hpp"
 
