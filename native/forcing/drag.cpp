@@ -8,6 +8,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "engine/prefetch.hpp"
 #include "geometry/lane_isa.hpp"
 #include "geometry/lanes4.hpp"
 #include "parallel/thread_pool.hpp"
@@ -347,7 +348,7 @@ template <class Slot>
 FLOEDEM_LANES void prefetch_ahead(const Slot* slot, std::uint32_t j) {
   constexpr std::uint32_t kAhead = 4;  // slots
   const auto at = reinterpret_cast<std::uintptr_t>(slot + 0) + (j + kAhead) * sizeof(Slot);
-  for (std::size_t line = 0; line < sizeof(Slot); line += 64) __builtin_prefetch(reinterpret_cast<const void*>(at + line));
+  prefetch_lines(reinterpret_cast<const void*>(at), sizeof(Slot));
 }
 
 /// Where the four floes' state is (their bodies' entries in the state and the sums), and

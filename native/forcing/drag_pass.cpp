@@ -6,6 +6,7 @@
 #include <cstring>
 #include <span>
 
+#include "engine/prefetch.hpp"
 #include "geometry/lane_isa.hpp"
 #include "geometry/lanes4.hpp"
 #include "parallel/thread_pool.hpp"
@@ -114,8 +115,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
     // The slots a few edges on, asked for ahead of their loads (as drag.cpp's prefetch_ahead:
     // the step evicts them; the next group's follow this one's). A prefetch changes no value.
     const auto ahead = reinterpret_cast<std::uintptr_t>(slot + 0) + (j + 4) * sizeof(DragPass::Slot);
-    for (std::size_t line = 0; line < sizeof(DragPass::Slot); line += 64)
-      __builtin_prefetch(reinterpret_cast<const void*>(ahead + line));
+    prefetch_lines(reinterpret_cast<const void*>(ahead), sizeof(DragPass::Slot));
     const DragPass::Slot& e = slot[j];
     const DragPass::Slot& next = slot[j + 1];
     const v4m past = v4m{} + static_cast<std::int64_t>(j) >= count;

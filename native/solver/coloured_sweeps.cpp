@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "engine/prefetch.hpp"
 #include "geometry/lane_isa.hpp"
 #include "geometry/lanes4.hpp"
 #include "parallel/thread_pool.hpp"
@@ -490,9 +491,7 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
   for (std::size_t i = 0; !on_threads && i < m.size(); ++i) {
     // What pack_lane reads of the manifold four on (its first 320 bytes; the colouring's
     // prefetch warmed only the first line). A prefetch changes no value.
-    if (i + 4 < m.size())
-      for (std::size_t line = 0; line < 320; line += 64)
-        __builtin_prefetch(reinterpret_cast<const char*>(&m[i + 4]) + line);
+    if (i + 4 < m.size()) prefetch_lines(&m[i + 4], 320);
     const Manifold& c = m[i];
     const Vec2 t = perp(c.normal);
     auto warm = [&](const ManifoldPoint& q) {

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "engine/prefetch.hpp"
 #include "solver/coloured_sweeps.hpp"
 #include "solver/headroom.hpp"
 #include "solver/sweep_pipeline.hpp"
@@ -410,9 +411,7 @@ double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const
     // The manifold four on, every line of it asked for ahead: this sweep reads the first line,
     // each point's and the reference face's (the last), out of cache at 16k floes, and its
     // hottest load waited on the last line (perf). A prefetch changes no value.
-    if (i + 4 < nm)
-      for (std::size_t line = 0; line < sizeof(Manifold); line += 64)
-        __builtin_prefetch(reinterpret_cast<const char*>(&manifolds[i + 4]) + line);
+    if (i + 4 < nm) prefetch_lines(&manifolds[i + 4], sizeof(Manifold));
     work.ends[2 * i] = manifolds[i].body_a;
     work.ends[2 * i + 1] = manifolds[i].body_b;
     deepest = std::max(deepest, measure(i));

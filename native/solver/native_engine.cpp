@@ -16,6 +16,7 @@
 #include <limits>
 #include <vector>
 
+#include "engine/prefetch.hpp"
 #include "solver/broad_phase.hpp"
 #include "solver/pair_cache.hpp"
 #include "solver/contact_islands.hpp"
@@ -39,16 +40,6 @@ std::vector<Manifold>::const_iterator find_pair(const std::vector<Manifold>& lis
                           [](const Manifold& m, PartPair p) { return PartPair{m.part_a, m.part_b} < p; });
 }
 
-/// Asks for the cache lines of `bytes` bytes from `at` (for writing with `write`). Changes no value.
-inline void prefetch_lines(const void* at, std::size_t bytes, bool write = false) {
-  const auto* const p = static_cast<const char*>(at);
-  for (std::size_t line = 0; line < bytes; line += 64) {
-    if (write)
-      __builtin_prefetch(p + line, 1);
-    else
-      __builtin_prefetch(p + line);
-  }
-}
 // What the contact list reads of a manifold of the last list, and writes of the new one: the
 // first 320 bytes (its pair and both points' ids, impulses and kinds), of 384.
 constexpr std::size_t kManifoldReadBytes = 320;
@@ -552,7 +543,8 @@ void NativeEngine::collide_pairs(bool redetection) {
       // sorted by first part), and collide()'s first loads of it, and of the reference face's
       // frame data, waited on memory (perf: about a tenth of its samples at 16k floes). A
       // prefetch changes no value.
-      if (k + kPrefetchPairs < end) {
+      // A pair whose manifold is reused is not collided: its geometry is not asked for.
+      if (k + kPrefetchPairs < end && !(may_reuse && reuse_[k + kPrefetchPairs] >= 0)) {
         const PartPair ahead = pairs_[k + kPrefetchPairs];
         parts_.prefetch_world(ahead.b);
         parts_.prefetch_local(ahead.b);
@@ -609,7 +601,7 @@ void NativeEngine::build_contact_list() {
       const PartPair pair = pairs_[k];
       if (narrow_points_[k] == 0) continue;
       if (old + 2 < previous_manifolds_.size()) prefetch_lines(&previous_manifolds_[old + 2], kManifoldReadBytes);
-      if (slot + 2 < contacts) prefetch_lines(&manifolds_[slot + 2], kManifoldReadBytes, /*write=*/true);
+      if (slot + 2 < contacts) prefetch_lines(&manifolds_[slot + 2], kManifoldReadBytes);
       const NarrowManifold& found = narrow_[k];  // narrow_ keeps the narrow phase's own result (reuse)
       Manifold& m = manifolds_[slot++];
       fill_manifold(found, m);
