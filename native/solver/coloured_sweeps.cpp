@@ -196,16 +196,16 @@ FLOEDEM_LANES void finish(const SweepBundle& b, const BundleRun& r, Vec2* v, dou
 // from memory (some 50 MB): the sweep waited on each bundle's first loads (perf: a third of the
 // 100k sweep's samples on the first loads of a bundle and its points). Each pair of bundles
 // asks for the pair two on (bundles four on, 3 KB ahead; eight on gave the same). A prefetch
-// changes no value. Measured (2-core AMD EPYC VM, Zen 4, one
-// thread, builds side by side, cores swapped): the 100k field's contact solve 69.4 and 72.6 ->
-// 48.2 and 52.7 ms a step; the 16k field's 7.8 and 7.2 -> 7.0 and 6.3 ms; in cache (the 1k
-// BM_ContactSweepsColoured) 2 % slower.
+// changes no value. Measured (2-core AMD EPYC VM, Zen 4, one thread, builds side by side,
+// cores swapped): the 100k field's contact solve 69.4 and 72.6 -> 48.2 and 52.7 ms a step; the
+// 16k field's 7.8 and 7.2 -> 7.0 and 6.3 ms; in cache (the 1k BM_ContactSweepsColoured) 2 %
+// slower.
 constexpr std::size_t kSweepAhead = 4;
 
 FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
   v4d largest_change = splat(0.0), largest_impulse = splat(0.0), size = splat(0.0);
   // An address, not a pointer into the span: near its end it names the bundles after it (the
-  // colour's next block, swept next) or memory past the array, which a prefetch never faults on.
+  // colour's next block) or memory past the array, which a prefetch never faults on.
   const std::uintptr_t ahead = reinterpret_cast<std::uintptr_t>(bundles.data()) + kSweepAhead * sizeof(SweepBundle);
   std::size_t i = 0;
   for (; i + 1 < bundles.size(); i += 2) {
