@@ -15,4 +15,14 @@ namespace floedem {
   for (std::size_t line = 0; line < bytes; line += 64) __builtin_prefetch(reinterpret_cast<const void*>(first + line));
 }
 
+/// prefetch_lines for record `index` of the array at `first` (`bytes` from its start: one record
+/// unless told), `index` taken as an offset, not a subscript: it may name a record past the
+/// array's end (a loop asking a few records ahead, near its last), which is never formed as a
+/// pointer.
+template <class Record>
+[[gnu::always_inline]] inline void prefetch_record(const Record* first, std::size_t index,
+                                                   std::size_t bytes = sizeof(Record)) {
+  prefetch_lines(reinterpret_cast<const void*>(reinterpret_cast<std::uintptr_t>(first) + index * sizeof(Record)), bytes);
+}
+
 }  // namespace floedem

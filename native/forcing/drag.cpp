@@ -347,8 +347,7 @@ static_assert(sizeof(v4d) == sizeof(double) * kQuad);
 template <class Slot>
 FLOEDEM_LANES void prefetch_ahead(const Slot* slot, std::uint32_t j) {
   constexpr std::uint32_t kAhead = 4;  // slots
-  const auto at = reinterpret_cast<std::uintptr_t>(slot + 0) + (j + kAhead) * sizeof(Slot);
-  prefetch_lines(reinterpret_cast<const void*>(at), sizeof(Slot));
+  prefetch_record(slot, std::size_t{j} + kAhead);
 }
 
 /// Where the four floes' state is (their bodies' entries in the state and the sums), and

@@ -114,8 +114,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
   for (std::uint32_t j = 0; j < edges; ++j) {
     // The slots a few edges on, asked for ahead of their loads (as drag.cpp's prefetch_ahead:
     // the step evicts them; the next group's follow this one's). A prefetch changes no value.
-    const auto ahead = reinterpret_cast<std::uintptr_t>(slot + 0) + (j + 4) * sizeof(DragPass::Slot);
-    prefetch_lines(reinterpret_cast<const void*>(ahead), sizeof(DragPass::Slot));
+    prefetch_record(slot, j + 4);
     const DragPass::Slot& e = slot[j];
     const DragPass::Slot& next = slot[j + 1];
     const v4m past = v4m{} + static_cast<std::int64_t>(j) >= count;

@@ -204,13 +204,11 @@ constexpr std::size_t kSweepAhead = 4;
 
 FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
   v4d largest_change = splat(0.0), largest_impulse = splat(0.0), size = splat(0.0);
-  // An address, not a pointer into the span: near its end it names the bundles after it (the
-  // colour's next block) or memory past the array, which a prefetch never faults on.
-  const std::uintptr_t ahead = reinterpret_cast<std::uintptr_t>(bundles.data()) + kSweepAhead * sizeof(SweepBundle);
   std::size_t i = 0;
   for (; i + 1 < bundles.size(); i += 2) {
     SweepBundle &b0 = bundles[i], &b1 = bundles[i + 1];
-    prefetch_lines(reinterpret_cast<const void*>(ahead + i * sizeof(SweepBundle)), 2 * sizeof(SweepBundle));
+    // Near the span's end: the colour's next block, or past the array (never faults).
+    prefetch_record(bundles.data(), i + kSweepAhead, 2 * sizeof(SweepBundle));
     BundleRun r0 = start(b0, v, w), r1 = start(b1, v, w);
     v4d sq0[2], sq1[2];
     const int both = std::min(b0.points, b1.points);
