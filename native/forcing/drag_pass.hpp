@@ -26,6 +26,7 @@
 #include <span>
 #include <vector>
 
+#include "engine/line_vector.hpp"
 #include "forcing/drag.hpp"
 
 namespace floedem {
@@ -78,9 +79,9 @@ class DragPass {
  private:
   std::vector<const DistributedDrag*> terms_;
   Shape shape_;
-  std::vector<Group> groups_;
-  std::vector<Slot> slots_;
-  std::vector<Moments> moments_;  // one per group, read in the groups' order
+  LineVector<Group> groups_;
+  LineVector<Slot> slots_;
+  LineVector<Moments> moments_;  // one per group, read in the groups' order
   std::vector<std::uint8_t> shared_;  // per body: 1 where the pass adds it
   std::size_t floes_ = 0;
   /// The groups to visit this step (drag_pass.cpp).

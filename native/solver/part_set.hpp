@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "engine/line_vector.hpp"
 #include "scene/scene.hpp"
 #include "solver/narrow_phase.hpp"
 
@@ -58,10 +59,10 @@ class PartSet {
   std::vector<std::uint8_t> immovable_;
   std::vector<std::int32_t> first_;  // first vertex of part k; part k ends at first_[k + 1]
   std::vector<std::int32_t> first_part_;  // first part of body b; its parts end at first_part_[b + 1]
-  std::vector<Vec2> local_vertices_, local_normals_;
-  std::vector<Vec2> world_vertices_, world_normals_;
+  LineVector<Vec2> local_vertices_, local_normals_;
+  LineVector<Vec2> world_vertices_, world_normals_;
   std::vector<double> radius_;
-  std::vector<Aabb> boxes_;
+  LineVector<Aabb> boxes_;
   std::vector<Vec2> placed_position_;  // per part: the pose it was last placed at (NaN: never)
   std::vector<Rot> placed_rotation_;
   std::vector<std::uint8_t> kept_;

@@ -1,0 +1,36 @@
+#pragma once
+// std::vector whose storage starts on a 64-byte cache line. malloc gives 16-byte alignment (a
+// large block: a page plus its 16-byte header), so a record of a whole number of lines (a
+// 384-byte manifold, a box floe's four 16-byte vertices) straddled one line more than it fills:
+// every pass over it read, and every prefetch of it had to ask for, an extra line. Measured
+// (2-core AMD EPYC VM, the 16k field side by side, four rounds): the median step about 4 % less
+// with the manifolds, the narrow phase's slots, the parts' geometry and bounds and the drag
+// pass's records so; the same results to the bit (an allocation's address changes no value).
+#include <cstddef>
+#include <new>
+#include <vector>
+
+namespace floedem {
+
+inline constexpr std::size_t kCacheLine = 64;
+
+template <class T>
+struct LineAllocator {
+  using value_type = T;
+  LineAllocator() = default;
+  template <class U>
+  constexpr LineAllocator(const LineAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) {
+    return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{kCacheLine}));
+  }
+  void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, std::align_val_t{kCacheLine}); }
+  template <class U>
+  bool operator==(const LineAllocator<U>&) const noexcept {
+    return true;
+  }
+};
+
+template <class T>
+using LineVector = std::vector<T, LineAllocator<T>>;
+
+}  // namespace floedem
