@@ -10,9 +10,9 @@
 #include <new>
 #include <vector>
 
-namespace floedem {
+#include "engine/cache_line.hpp"
 
-inline constexpr std::size_t kCacheLine = 64;
+namespace floedem {
 
 template <class T>
 struct LineAllocator {

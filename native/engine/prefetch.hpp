@@ -5,14 +5,16 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "engine/cache_line.hpp"
+
 namespace floedem {
 
-/// Asks for every 64-byte line of the `bytes` bytes from `at`. `at` may lie past the end of the
+/// Asks for every cache line of the `bytes` bytes from `at`. `at` may lie past the end of the
 /// caller's array (a prefetch of an address never faults): it is taken as an address, not
 /// dereferenced. Always inline: called from loops built for several ISAs (gnu::target).
 [[gnu::always_inline]] inline void prefetch_lines(const void* at, std::size_t bytes) {
   const auto first = reinterpret_cast<std::uintptr_t>(at);
-  for (std::size_t line = 0; line < bytes; line += 64) __builtin_prefetch(reinterpret_cast<const void*>(first + line));
+  for (std::size_t line = 0; line < bytes; line += kCacheLine) __builtin_prefetch(reinterpret_cast<const void*>(first + line));
 }
 
 /// prefetch_lines for record `index` of the array at `first` (`bytes` from its start: one record

@@ -42,8 +42,10 @@ auto find_pair(const List& list, PartPair pair) {
                           [](const auto& m, PartPair p) { return PartPair{m.part_a, m.part_b} < p; });
 }
 
-// What the contact list writes of a new manifold first: its first 320 bytes (its pair and both
-// points' ids, impulses and kinds), of 384.
+// What the contact list asks for ahead of writing a new manifold: its first five lines, 320 of
+// its 384 bytes (pair, bodies, normal, friction and all of the first point and most of the
+// second, which fill_manifold writes); the last line, the second point's end and the reference
+// face, is written too and left to the hardware's prefetch.
 constexpr std::size_t kManifoldWriteBytes = 320;
 
 /// What the next step's contact list reads of one of this step's contacts: its pair, and each

@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "engine/cache_line.hpp"
+
 namespace floedem {
 
 inline constexpr int kBundleLanes = 4;
@@ -21,7 +23,7 @@ struct BundlePoint {
 /// Up to four manifolds of one colour (no two share a moving body), structure of arrays. An
 /// empty lane reads lane 0's bodies, has zero inverse masses (never written back) and no impulse.
 /// 768 bytes: 192 a manifold against two 112-byte rows in pair order.
-struct alignas(64) SweepBundle {
+struct alignas(kCacheLine) SweepBundle {
   std::int32_t body_a[kBundleLanes], body_b[kBundleLanes];
   std::int32_t manifold[kBundleLanes];  ///< each lane's manifold (its place in the solve), -1 if none
   std::int32_t points = 0;  ///< 1 or 2: the most points of its manifolds

@@ -30,6 +30,7 @@
 #include <span>
 #include <vector>
 
+#include "engine/cache_line.hpp"
 #include "solver/contact_solver.hpp"
 
 namespace floedem {
@@ -73,7 +74,7 @@ class SweepPipeline {
     Vec2 velocity;
     double angular_velocity = 0.0;
   };
-  struct alignas(64) Part {  // a cache line of its own: each thread writes its part's
+  struct alignas(kCacheLine) Part {  // a cache line of its own: each thread writes its part's
     std::vector<PartRow> rows;
     std::vector<Wait> waits;                   // in the order of their rows
     std::vector<BodyLog> body_log;             // a speculative sweep's first write of each body
@@ -82,10 +83,10 @@ class SweepPipeline {
     std::size_t logged_rows = 0;
     int logged_sweep = -1;                     // the sweep the log is of (-1: none)
   };
-  struct alignas(64) Counter {
+  struct alignas(kCacheLine) Counter {
     std::atomic<std::int64_t> value{0};
   };
-  struct alignas(64) SweepSlot {
+  struct alignas(kCacheLine) SweepSlot {
     std::atomic<int> finished{0};  // parts done with the sweep
   };
   static constexpr int kSlots = 4;  // sweeps in flight at once: at most two
