@@ -31,6 +31,6 @@ def equal_area_diameters(f):
 
 
 def truncated_power_law_survival(d, alpha, d_min, d_max):
-    """S(d) = (d^-alpha - d_max^-alpha) / (d_min^-alpha - d_max^-alpha) (MODEL.md section 5)."""
+    """S(d) = (d^-alpha - d_max^-alpha) / (d_min^-alpha - d_max^-alpha) (docs/model.md section 5)."""
     d = np.clip(d, d_min, d_max)
     return (d ** -alpha - d_max ** -alpha) / (d_min ** -alpha - d_max ** -alpha)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Impact suite (MODEL.md section 4), the report's first section.
+"""Impact suite (docs/model.md section 4), the report's first section.
 
 Two parts, both from the four scenarios of scenarios/impacts/:
 - impulses and restitution: every engine with its rigid (impulse) contact, e from 0 to 0.9, the
@@ -37,7 +37,7 @@ RIGID_E = (0.0, 0.1, 0.5, 0.9)
 #   and J within 0.1 % of (1 + e) m_eff u head-on. Oblique (friction and rotation couple the
 #   normal and tangential impulses: no one-line closed form), J within 0.5 % of native's:
 #   Bullet's 1 cm collision margin moves the contact point by up to 1 mm on a 10 m floe.
-# - compliant durations: a spring-dashpot that cannot pull lets go at t_c (MODEL.md 4); t_c
+# - compliant durations: a spring-dashpot that cannot pull lets go at t_c (docs/model.md 4); t_c
 #   holds for a single point along the line of centres. ODE's soft contact within 15 % of it (up to
 #   11 % measured, on the oblique cases, where the lever arm moves during the pulse), Bullet within
 #   25 % (up to 22 % measured: it drops and re-adds manifold points during the deep pulses of the
@@ -140,7 +140,7 @@ def read(run, rel_to):
 
 
 def release_time(e, m_eff, c_tau):
-    """t_c of a linear spring-dashpot that cannot pull (MODEL.md 4, Schwager and Poeschel 2007),
+    """t_c of a linear spring-dashpot that cannot pull (docs/model.md 4, Schwager and Poeschel 2007),
     with the references' zeta(e) = -ln e / sqrt(pi^2 + ln^2 e) and k = (pi / C_tau)^2."""
     zeta = 1.0 if e <= 0.0 else -math.log(e) / math.sqrt(math.pi ** 2 + math.log(e) ** 2)
     k = (math.pi / c_tau) ** 2
@@ -197,7 +197,7 @@ def summarize(runs, rel_to, fig_dir, quick):
            f"C_tau = {C_TAU:g} s kg^-1/2 (k = {(math.pi / C_TAU) ** 2:.3g} N/m), e = 0.1. Native estimates the "
            "duration from the impulse, tau = C_tau sqrt(m_eff); ODE and Bullet measure it on a compliant "
            "spring-dashpot with the same k, which lets go at t_c = 0.741 pi sqrt(m_eff / k) for e = 0.1 "
-           "(MODEL.md 4).", "", "![duration against effective mass](fig/impact_durations.png)", "",
+           "(docs/model.md 4).", "", "![duration against effective mass](fig/impact_durations.png)", "",
            "| engine | exponent of tau on m_eff | m_eff range (kg) | measured / t_c (mean, range) | cases |",
            "|---|---|---|---|---|"]
     fig, ax = plt.subplots(figsize=(7, 5))

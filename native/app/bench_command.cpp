@@ -32,8 +32,7 @@ constexpr const char* kHeader =
 
 /// The processor as far as this machine tells: its model name, and its family, model and cache
 /// sizes, since a virtual machine's model name alone ("AMD EPYC") names processors generations
-/// apart (measured: Box2D's 16k field step 55 ms on one such machine, 32 on another, native's
-/// 24 and 20: the speed ratios of a report belong to the machine it ran on).
+/// apart, and the speed ratios of a report belong to the machine it ran on.
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
   std::string line, name = "unknown", family, model;

@@ -53,7 +53,7 @@ const char* describe(DurationModel model) {
   return model == DurationModel::measured
              ? "measured on a compliant contact: first to last step with contact force; peak = largest step "
                "impulse / dt; mean = J / duration"
-             : "estimated from the impulse: tau = duration_coefficient sqrt(effective_mass) (MODEL.md 4)";
+             : "estimated from the impulse: tau = duration_coefficient sqrt(effective_mass) (docs/model.md 4)";
 }
 
 CollisionTracker::CollisionTracker(const Scene& scene, DurationModel model)

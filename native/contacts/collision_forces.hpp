@@ -1,5 +1,5 @@
 #pragma once
-// Collision forces from impulses (MODEL.md section 4; the paper's central proposal).
+// Collision forces from impulses (docs/model.md section 4; the paper's central proposal).
 //
 // The solver resolves a collision within one step, but a real one lasts longer: about
 //   tau = C_tau sqrt(m_eff),   m_eff = 1 / (n . M^-1 n)
@@ -39,7 +39,7 @@ struct CollisionRow {
   double peak_force = 0.0;            ///< N, pi J / (2 tau)
 };
 
-/// MODEL.md 4: the half-sine pulse of a linear spring.
+/// docs/model.md 4: the half-sine pulse of a linear spring.
 double collision_duration(double duration_coefficient, double effective_mass);
 double collision_mean_force(double impulse, double duration);
 double collision_peak_force(double impulse, double duration);
@@ -58,7 +58,7 @@ enum class DurationModel : std::uint8_t { estimated, measured };
 DurationModel duration_model_of(const EngineInfo& engine);
 const char* describe(DurationModel model);
 
-/// The compliant contact the reference engines use for measured durations (MODEL.md 4): a
+/// The compliant contact the reference engines use for measured durations (docs/model.md 4): a
 /// linear spring k = (pi / C_tau)^2, so that its undamped half-sine lasts native's estimate
 /// C_tau sqrt(m_eff), and a dashpot c = 2 zeta sqrt(k m_eff) with zeta from the restitution,
 /// e = exp(-zeta pi / sqrt(1 - zeta^2)) <=> zeta = -ln e / sqrt(pi^2 + ln^2 e) (e = 0: zeta = 1).

@@ -2,10 +2,8 @@
 // std::vector whose storage starts on a 64-byte cache line. malloc gives 16-byte alignment (a
 // large block: a page plus its 16-byte header), so a record of a whole number of lines (a
 // 384-byte manifold, a box floe's four 16-byte vertices) straddled one line more than it fills:
-// every pass over it read, and every prefetch of it had to ask for, an extra line. Measured
-// (2-core AMD EPYC VM, the 16k field side by side, four rounds): the median step about 4 % less
-// with the manifolds, the narrow phase's slots, the parts' geometry and bounds and the drag
-// pass's records so; the same results to the bit (an allocation's address changes no value).
+// every pass over it read, and every prefetch of it had to ask for, an extra line. An
+// allocation's address changes no value, so the results are the same to the bit.
 #include <cstddef>
 #include <new>
 #include <vector>

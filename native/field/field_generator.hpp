@@ -1,5 +1,5 @@
 #pragma once
-// Broken-ice field generator (MODEL.md section 5): a rectangular domain filled with
+// Broken-ice field generator (docs/model.md section 5): a rectangular domain filled with
 // non-overlapping, randomly shaped convex floes at a given concentration, whose equal-area
 // diameters follow a truncated power law.
 //

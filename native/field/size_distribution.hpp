@@ -1,5 +1,5 @@
 #pragma once
-// The truncated power law of floe sizes (MODEL.md section 5): the number of floes larger than
+// The truncated power law of floe sizes (docs/model.md section 5): the number of floes larger than
 // d falls as d^-alpha between d_min and d_max, d = sqrt(4 A / pi) the equal-area diameter.
 //   survival   S(d) = (d^-alpha - d_max^-alpha) / (d_min^-alpha - d_max^-alpha)
 //   density    p(d) = alpha d^-(alpha+1) / (d_min^-alpha - d_max^-alpha)

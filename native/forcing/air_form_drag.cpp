@@ -1,4 +1,4 @@
-// Air form drag on the sail (MODEL.md 2; Bigg et al. 1997):
+// Air form drag on the sail (docs/model.md 2; Bigg et al. 1997):
 //   F = 1/2 rho_a C_a A_sail |V_a - v| (V_a - v),  A_sail = projected width x freeboard,
 // integrated over the waterline polygon (drag.hpp), which gives its torque too.
 #include "forcing/drag.hpp"

@@ -1,4 +1,4 @@
-// Air skin drag on the top (MODEL.md 2): F = rho_a C_da A_top |V_a - v| (V_a - v),
+// Air skin drag on the top (docs/model.md 2): F = rho_a C_da A_top |V_a - v| (V_a - v),
 // integrated over the waterline polygon (drag.hpp), which gives its torque too.
 #include "forcing/drag.hpp"
 

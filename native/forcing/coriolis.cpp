@@ -1,4 +1,4 @@
-// Coriolis (MODEL.md 2): F = -m f k x v, f = 2 Omega sin(latitude). Contributes its rate f
+// Coriolis (docs/model.md 2): F = -m f k x v, f = 2 Omega sin(latitude). Contributes its rate f
 // per body; forcing.cpp turns the velocity by exactly f' dt per step (trapezoidal rule with a
 // tangent-corrected rate), so the inertial circle neither grows nor drifts in phase.
 #include "forcing/force_term.hpp"

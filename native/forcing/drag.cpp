@@ -341,9 +341,8 @@ static_assert(sizeof(v4d) == sizeof(double) * kQuad);
 // step a drag term's slots (about 5 MB) come back from memory each step, after the rest of the
 // step has moved them out of cache, and the loop's first load of each slot waited for them
 // (perf: over a third of the loop's samples). The next group's slots follow this one's, so
-// near a group's end this fetches the next one's first. A prefetch changes no value. Measured:
-// the forcing stage 0.93-0.96 -> 0.86-0.87 of the narrow phase's time (floedem bench --stages,
-// alternating runs); BM_DragQuadrature, whose slots stay in L3 between calls, is unchanged.
+// near a group's end this fetches the next one's first. A prefetch changes no value.
+// BM_DragQuadrature, whose slots stay in cache between calls, does not show the gain.
 template <class Slot>
 FLOEDEM_LANES void prefetch_ahead(const Slot* slot, std::uint32_t j) {
   constexpr std::uint32_t kAhead = 4;  // slots
@@ -645,7 +644,7 @@ void DistributedDrag::add_slab_bound(std::array<double, 2>& b, const std::array<
 }
 
 void DistributedDrag::add_entry_bound(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {
-  // Per quadrature point, with m = |u| <= |V - v| + |w| |r| and k its weight (MODEL.md 2):
+  // Per quadrature point, with m = |u| <= |V - v| + |w| |r| and k its weight (docs/model.md 2):
   //   skin  a = k (m I + u u^T / m):    |a_00| + |a_01| <= (1 + sqrt 2) |k| m,  g^T a g <= 2 |k| m |r|^2
   //   form  a = k (-(u.n) I - u n^T):   the same two bounds (|u.n| <= m, |n_x| + |n_y| <= sqrt 2)
   //   linearised (m -> U_ref):          |k| U_ref and |k| U_ref |r|^2

@@ -4,7 +4,7 @@
 // Form drag on an edge element of length dl (outward normal n) that faces the relative flow
 // u = V - (v + w k x r) (u.n < 0), per unit height:  dF = 1/2 rho C (-u.n) u dl.
 // Summed over a convex outline in a uniform flow, sum dl max(0, -n.u^) is the projected
-// width normal to the flow, so F = 1/2 rho C (W h) |u| u: the form drag of MODEL.md 2 with the
+// width normal to the flow, so F = 1/2 rho C (W h) |u| u: the form drag of docs/model.md 2 with the
 // width measured on the polygon. Skin drag on an area element: dF = rho C |u| u dA.
 // Integrating both over the polygon with the local velocity gives the rotational damping torque.
 // Edges: 2-point Gauss rule; area: centroid fan of signed triangles, 3-point edge-midpoint rule

@@ -1,5 +1,5 @@
 #pragma once
-// Non-contact forcing as small independent units (MODEL.md section 2). Each term adds, per
+// Non-contact forcing as small independent units (docs/model.md section 2). Each term adds, per
 // body, its generalised force Q = (F_x, F_y, torque) at the start of the step and, where it
 // depends on the body's velocity, the Jacobian dQ/dq with q = (v_x, v_y, omega); Coriolis adds
 // a rotation rate instead. Forcing (forcing.cpp) then takes one linearly implicit step per body

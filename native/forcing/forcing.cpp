@@ -12,7 +12,7 @@
 // still by contacts would see its drag under-reported by the factor 1 / (1 + dt |D| / M)
 // (0.2 % for a 10 m floe at dt = 0.05 s), and ice loads are what users read. Coriolis is trapezoidal (Cayley) with f~ = (2/dt) tan(f' dt / 2),
 // f' = f m / m_I, which turns the velocity by exactly f' dt per step: no drift of the speed
-// and no phase error, so the inertial circle closes (issue 3 asks 1e-4 of the radius after 10
+// and no phase error, so the inertial circle closes (the requirement is 1e-4 of the radius after 10
 // periods at dt = 60 s). The first step turns by half of that: symplectic Euler is a leapfrog
 // whose velocities sit at half steps, and starting them there puts the circle's centre in the
 // right place (an offset of f dt / 2 of the radius otherwise). For a linear drag the scheme's

@@ -1,4 +1,4 @@
-// Rope towing (MODEL.md 6): an elastic rope from a tug moving on a prescribed path to a point
+// Rope towing (docs/model.md 6): an elastic rope from a tug moving on a prescribed path to a point
 // on the iceberg. Tension T = k (L - L0) + c dL/dt when taut (L > L0) and T > 0, else 0 (a
 // rope cannot push); it acts along the rope at the attachment point (force and torque).
 // The rope's stiffness and damping along its direction enter the Jacobian (stiffness as

@@ -1,4 +1,4 @@
-// Sea-surface tilt, the pressure gradient that drives a geostrophic current (MODEL.md 2;
+// Sea-surface tilt, the pressure gradient that drives a geostrophic current (docs/model.md 2;
 // Bigg et al. 1997): F = m (dV_w/dt + f k x V_w). The current is steady here, so
 // F = m f k x V_w, with V_w the current averaged over the body's draft.
 #include "forcing/force_term.hpp"

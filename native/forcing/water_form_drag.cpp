@@ -1,4 +1,4 @@
-// Water form drag on the keel (MODEL.md 2; Bigg et al. 1997):
+// Water form drag on the keel (docs/model.md 2; Bigg et al. 1997):
 //   F = 1/2 rho_w C_w A_keel |V_w - v| (V_w - v),  A_keel = projected width x draft,
 // by keel layer (each slab of the keel in the current of its depth), integrated over the
 // waterline polygon (drag.hpp), which also gives the rotational damping torque.

@@ -1,4 +1,4 @@
-// Water skin drag on the bottom (MODEL.md 2): F = rho_w C_dw A_bottom |V_w - v| (V_w - v),
+// Water skin drag on the bottom (docs/model.md 2): F = rho_w C_dw A_bottom |V_w - v| (V_w - v),
 // integrated over the bottom (the waterline polygon, scaled as the lowest keel layer) in the
 // current at the bottom's depth; the integral gives the rotational damping torque.
 #include "forcing/drag.hpp"

@@ -1,4 +1,4 @@
-// Wave radiation force (MODEL.md 2; Bigg et al. 1997): F = 1/2 rho_w C_r g a^2 L along the
+// Wave radiation force (docs/model.md 2; Bigg et al. 1997): F = 1/2 rho_w C_r g a^2 L along the
 // wave direction, L the waterline length facing the waves: the polygon's width normal to
 // the wave direction, measured each step on the turned polygon. Applied at the centroid.
 #include <algorithm>

@@ -113,10 +113,6 @@ FLOEDEM_LANES void take(const v4d& s, int g, int count, FaceSeparation& best) {
 /// bit, -0 and +0 included. Lanes past the last edge repeat edge 0 and are not read. The narrow
 /// phase's search: at a packed field's pairs the shortcuts' branches, taken or not by the data,
 /// cost more than the products they save (BM_NarrowPhase). Elsewhere, the plain loop.
-/// Measured against the former search (two SSE2 registers per four edges, a pass over `b` per
-/// four, in every build), 2-core Intel VM, AVX-512 build, alternating runs: BM_NarrowPhase (the
-/// 1k field, in cache) 136, 139, 116 -> 122, 120, 104 ns a pair; in the 4k field's step
-/// (floedem bench --stages, six runs each) the narrow phase 0.81 -> 0.79 of the contact solve.
 [[gnu::always_inline]] inline FaceSeparation max_face_separation_lanes(const ConvexView& a, const ConvexView& b) {
   using lanes4::splat;
   using sat_lanes::v4d;

@@ -1,5 +1,5 @@
 #pragma once
-// The kinetic energy balance of a run, step by step (issue 9: no spurious energy gain).
+// The kinetic energy balance of a run, step by step (no spurious energy gain).
 //
 // Every engine is handed the same non-contact loads, constant over the step (force F, torque
 // T, and for Coriolis alone an exact turn of the velocity), and moves the bodies on a

@@ -215,7 +215,7 @@ EnvironmentDefaults read_environment(TableReader& root, Scene& scene) {
   defaults.ice_density = r.real("ice_density", defaults.ice_density, Range::positive());
   if (r.has("latitude")) {
     const double degrees = r.real("latitude", 0.0, Range::closed(-90.0, 90.0));
-    constexpr double kEarthRotation = 7.2921e-5;  // rad/s, sidereal (MODEL.md 2)
+    constexpr double kEarthRotation = 7.2921e-5;  // rad/s, sidereal (docs/model.md 2)
     env.coriolis = true;
     env.latitude = degrees * M_PI / 180.0;
     env.coriolis_parameter = 2.0 * kEarthRotation * std::sin(env.latitude);

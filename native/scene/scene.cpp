@@ -40,13 +40,13 @@ void Scene::derive() {
     b.area = m.area;
     b.centroid = m.centroid;
     if (b.kind == BodyKind::floe) {
-      // Floating floe (MODEL.md 2): draft = h rho_i / rho_w, freeboard = h - draft.
+      // Floating floe (docs/model.md 2): draft = h rho_i / rho_w, freeboard = h - draft.
       b.mass = b.density * b.thickness * m.area;
       b.draft = b.thickness * b.density / environment.water_density;
       b.freeboard = b.thickness - b.draft;
       b.keel = {KeelLayer{0.0, b.draft, 1.0}};
     } else {
-      // Iceberg (MODEL.md 1): mass given, or rho_i A (draft + sail) times a shape factor.
+      // Iceberg (docs/model.md 1): mass given, or rho_i A (draft + sail) times a shape factor.
       b.mass = b.given_mass > 0.0 ? b.given_mass : b.density * m.area * b.thickness * b.shape_factor;
     }
     // Polar moment of a uniform prism: I = m J / A, J the polygon's polar moment of area.

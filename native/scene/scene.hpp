@@ -23,11 +23,11 @@ struct RunSettings {
 };
 
 struct ContactSettings {
-  double restitution = 0.1;          ///< Newton's coefficient e in [0, 1] (MODEL.md 3: 0.1 for ice)
+  double restitution = 0.1;          ///< Newton's coefficient e in [0, 1] (docs/model.md 3: 0.1 for ice)
   double friction = 0.3;             ///< Coulomb coefficient mu >= 0
   double collision_threshold = 1e-3; ///< m/s: approach speeds above this are collisions
-  /// C_tau, s kg^-1/2: a collision lasts tau = C_tau sqrt(m_eff) (MODEL.md 4). Default from the
-  /// field figures of MODEL.md 4: a 1e10 kg multi-year floe stopped by Hans Island at 0.5 m/s
+  /// C_tau, s kg^-1/2: a collision lasts tau = C_tau sqrt(m_eff) (docs/model.md 4). Default from the
+  /// field figures of docs/model.md 4: a 1e10 kg multi-year floe stopped by Hans Island at 0.5 m/s
   /// (J = 5.5e9 N s with e = 0.1) peaks near 600 MN for tau = pi J / (2 F) = 14 s, C_tau =
   /// 1.4e-4; Weber's station floe (of order 1e10 kg, m_eff ~ 5e9) accelerated over 20-40 s,
   /// C_tau ~ 1.3e-4 to 5e-4. Equivalent linear contact stiffness k = (pi / C_tau)^2 = 4.4e8 N/m.
@@ -43,7 +43,7 @@ struct OutputSettings {
   int load_every = 0;  ///< steps between rows of /loads (0: run.output_every)
 };
 
-/// Drag and radiation coefficients (MODEL.md section 2; Bigg et al. 1997 for icebergs).
+/// Drag and radiation coefficients (docs/model.md section 2; Bigg et al. 1997 for icebergs).
 struct DragCoefficients {
   double water_form = 0.9;      ///< C_w, keel form drag
   double water_skin = 5e-4;     ///< C_dw, bottom skin drag

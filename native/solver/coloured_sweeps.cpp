@@ -69,9 +69,8 @@ FLOEDEM_LANES void apply(const SweepBundle& b, const BundlePoint& p, v4d px, v4d
 // block is delassus_block (contact_solver.hpp), prepare_contact's own, on the same lever arms,
 // normal and inverse masses, and each reciprocal is correctly rounded, so every impulse is the
 // same to the bit as with the values stored. The divisions run beside the sweep's chain of
-// dependent operations. Measured (2-core Intel VM, builds side by side): the 100k field's
-// contact solve 93.8 -> 72.5 and 85.5 -> 66.7 ms a step (two rounds, the cores swapped); in cache (the
-// 1k field's BM_ContactSweepsColoured, alternating pairs) about 5 % slower.
+// dependent operations. It pays where the bundles come from memory; in cache the divisions
+// cost a little more than the loads they replace.
 using Delassus = DelassusBlock<v4d>;
 FLOEDEM_LANES Delassus delassus(const SweepBundle& b, const BundlePoint& p, v4d nx, v4d ny) {
   return delassus_block(load(b.ma), load(b.ia), load(b.mb), load(b.ib), load(p.rax), load(p.ray), load(p.rbx),
@@ -196,10 +195,7 @@ FLOEDEM_LANES void finish(const SweepBundle& b, const BundleRun& r, Vec2* v, dou
 // from memory (some 50 MB): the sweep waited on each bundle's first loads (perf: a third of the
 // 100k sweep's samples on the first loads of a bundle and its points). Each pair of bundles
 // asks for the pair two on (bundles four on, 3 KB ahead; eight on gave the same). A prefetch
-// changes no value. Measured (2-core AMD EPYC VM, Zen 4, one thread, builds side by side,
-// cores swapped): the 100k field's contact solve 69.4 and 72.6 -> 48.2 and 52.7 ms a step; the
-// 16k field's 7.8 and 7.2 -> 7.0 and 6.3 ms; in cache (the 1k BM_ContactSweepsColoured) 2 %
-// slower.
+// changes no value; in cache it costs a little.
 constexpr std::size_t kSweepAhead = 4;
 
 FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
@@ -402,9 +398,8 @@ void pack_lane(SweepBundle& b, int lane, const Manifold& c, std::size_t i, const
 }
 
 // The packing of a large solve on the pool's threads (an island of this many manifolds or more,
-// its colours swept on every thread): on one thread it took 8 % of the packed 16k field's step
-// (perf). Measured on 16 threads (alternating runs): the contact solve 5.94-5.99 -> 5.62-5.64
-// times the narrow phase's time; on 2, within the noise.
+// its colours swept on every thread): on one thread it was a serial part of the packed 16k
+// field's step that the threads could not shorten (perf).
 constexpr std::size_t kThreadedPacking = 4096;
 constexpr std::size_t kThreadedPackingMost = std::size_t{1} << 27;  // slots (4 a bundle) below kEmptiesSecond
 constexpr std::size_t kPackingBlock = 1024;            // manifolds a block of the threaded packing
@@ -577,7 +572,7 @@ void scatter_bundles(const Selection& m, std::span<const SweepBundle> bundles, s
 constexpr std::size_t kBlock = 64;  // bundles: 256 manifolds, about 5 us of a sweep
 // A colour goes to the pool only with this many blocks or more: the pool's join per colour and
 // sweep costs more than half of a colour of two or three blocks saves (the packed 4k field's
-// colours of about 100 bundles: its contact solve took 2.04 ms on two threads, 1.54 on one).
+// colours of about 100 bundles made its contact solve slower on two threads than on one).
 // Which thread sweeps a block changes no result, so neither does this bound.
 constexpr std::size_t kPoolBlocks = 4;
 SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, BodyArrays& s, double* change,

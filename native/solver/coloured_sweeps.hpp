@@ -12,7 +12,7 @@
 // body, so their updates commute: four of them (a bundle) are solved at once, lane by lane in
 // SIMD vectors, the local solve's cases all computed and the right one selected (no branch).
 // A manifold's two points are solved one after the other (a near block solve; solving every
-// first point before every second point cost convergence, issue 8). Fixed and towed bodies are
+// first point before every second point cost convergence). Fixed and towed bodies are
 // only read (as apply_impulse) and take no colour. A body with more than 63 manifolds sends the
 // rest to a last group, one manifold a bundle, swept in order.
 //
@@ -22,11 +22,8 @@
 // setting, not an optimisation of the default: results are not the pair order's to the bit).
 // Each lane's arithmetic is IEEE double, no fused multiply-add (CMakeLists), so the result is
 // the same on any x86-64, with or without AVX2 or AVX-512, and on any number of threads (a
-// large island's colours are swept in fixed blocks on the pool's threads).
-//
-// Measured (2-core AMD EPYC VM, one thread): the 1k field's step of sweeps 273-276 us against
-// 354-360 in pair order (BM_ContactSweeps*); the 16k field's contact solve 0.7 to 0.75 times
-// the pair order's (floedem bench --stages, alternating runs), with less mean penetration.
+// large island's colours are swept in fixed blocks on the pool's threads). docs/performance.md
+// has how it compares with the pair order.
 #include <cstdint>
 #include <span>
 #include <vector>

@@ -24,9 +24,8 @@ class PartSet {
   /// Per part: 1 where the last place() kept the part's placement (its body did not move).
   std::span<const std::uint8_t> kept() const { return kept_; }
 
-  /// Inline: the narrow phase asks for two a pair. Out of line, the call and the copy of its
-  /// result were 0.8 % of the 16k field's step (perf); inline, the narrow phase 0.777 -> 0.755
-  /// of the contact solve (floedem bench --stages, four runs each, alternating).
+  /// Inline: the narrow phase asks for two a pair, and out of line the call and the copy of its
+  /// result showed in the packed field's profile (perf).
   PartGeometry geometry(std::int32_t part, Vec2 position, Rot rotation) const {
     const std::int32_t first = first_[part];
     return PartGeometry{ConvexView{&world_vertices_[first], &world_normals_[first], first_[part + 1] - first},

@@ -16,7 +16,7 @@
 // step (a barrier per sweep would leave the later slab waiting for the earlier's rows at the cut).
 // This is wavefront (DOACROSS) scheduling of the sweep loop over its per-body dependences, with
 // coarse blocks; the fine-grained variant, level scheduling (Anderson and Saad 1989), waited on
-// every level and ran 2.7 times slower on two threads than one (issue 8, session 17).
+// every level and ran 2.7 times slower on two threads than one.
 //
 // The sweeps stop after the first sweep whose largest impulse change is within the tolerance
 // of its largest impulse, known only once every part has made that sweep. A part goes on into

@@ -1,5 +1,5 @@
 #pragma once
-// Towing (MODEL.md 6): the rope's state, and the towing force of each step.
+// Towing (docs/model.md 6): the rope's state, and the towing force of each step.
 #include <array>
 #include <span>
 

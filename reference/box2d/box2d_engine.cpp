@@ -1,6 +1,6 @@
 // Box2D 2.4 as a reference engine: the scene's polygons themselves (convex parts of at most
 // 8 vertices), mass and inertia set to floedem's values, not Box2D's.
-// Settings that matter (measured in shared/notes/reference-engines.md):
+// Settings that matter (measured in docs/engines.md):
 //  - restitution threshold 0 on every fixture: the default 1 m/s turns every drift-speed
 //    impact into e = 0;
 //  - polygon radius 0: the default 0.01 m skin moves the contact point off the vertex and

@@ -1,7 +1,7 @@
 // Bullet 3.24 (double precision) as a reference engine: each convex part an extruded prism
 // (btConvexHullShape), held in the plane by linear factor (1, 1, 0) and angular factor
 // (0, 0, 1), mass and planar inertia set to floedem's values.
-// Settings that matter (measured in shared/notes/reference-engines.md; Bullet's defaults give
+// Settings that matter (measured in docs/engines.md; Bullet's defaults give
 // e = 0.22, 0.62, or 0 instead of 0.3 on the same impact):
 //  - restitution of a pair = max, friction = min (the default multiplies both: mu 0.3 -> 0.09);
 //  - split impulse on for any penetration (m_splitImpulsePenetrationThreshold = 0), so that

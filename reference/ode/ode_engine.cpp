@@ -2,7 +2,7 @@
 // joint, mass and planar inertia set to floedem's values, contacts solved by ODE's QuickStep.
 // Contact points come from floedem's 2-D narrow phase (the prisms' side faces, projected):
 // ODE's own convex-convex collider returns one point per step on a top corner, which gave
-// e = 0.19 to 0.22 instead of 0.3 with spurious spin (shared/notes/reference-engines.md), so
+// e = 0.19 to 0.22 instead of 0.3 with spurious spin (docs/engines.md), so
 // only the contact *solution* is ODE's here; the geometry is the same as native's.
 // Settings that matter (measured in the notes):
 //  - QuickStep: dWorldStep caps friction at mu times the frictionless normal impulse and never

@@ -1,4 +1,4 @@
-"""Run time against error (issue 8), on three problems with a known answer, every engine, the
+"""Run time against error, on three problems with a known answer, every engine, the
 time step and the solver's iterations swept:
 
 - impact: two equal floes head-on (scenarios/impacts/floe_floe_headon.toml, e = 0.1): the

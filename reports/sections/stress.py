@@ -1,4 +1,4 @@
-"""Numerical stability under stress (issue 9): scenarios/stress/ on every engine, and the
+"""Numerical stability under stress: scenarios/stress/ on every engine, and the
 stability map. A run "holds" when it finishes (no NaN or infinity: floedem exits 4 on one),
 its deepest penetration stays below 1 % of the thinnest floe's thickness, no body moves faster
 than the case allows, no body ends up beyond a wall (tunnelling), the contacts make no energy
@@ -9,7 +9,7 @@ kinetic energy never rises above its start (summary attributes of each run: max_
 max_speed, contact_work, max_relative_energy_gain, max_kinetic_energy; the last frame for the
 walls).
 
-Why these bounds: 1 % of the thickness is the issue's bound (a floe 0.11 m thick may overlap
+Why these bounds: 1 % of the thickness is the required bound (a floe 0.11 m thick may overlap
 its neighbour by 1.1 mm); the speed bounds are what momentum allows (a floe struck by a body of
 speed V leaves at most at (1 + e) V, so 2 V is a generous bound for the unforced cases; wind
 and current drive floes at a few per cent of the wind, so 2 m/s bounds the jam). 1e-6 of a
@@ -189,7 +189,7 @@ def write(ctx):
         if o.case not in cases:
             cases.append(o.case)
     md = ["## Stability under stress", "",
-          "`scenarios/stress/` on every engine (issue 9). A run holds when it finishes without a non-finite state, its "
+          "`scenarios/stress/` on every engine. A run holds when it finishes without a non-finite state, its "
           f"deepest penetration stays below {PENETRATION_FRACTION:.0%} of the thinnest floe's thickness, no body moves "
           "faster than momentum allows (2 V for a body struck at V; 2 m/s under wind and current), none is pushed "
           "through a wall (its centroid beyond the wall's face at the end), the contacts make no energy (the kinetic "

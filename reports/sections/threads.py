@@ -1,4 +1,4 @@
-"""Threads (issue 8): native's step on 1 thread up to every core of the machine the report runs
+"""Threads: native's step on 1 thread up to every core of the machine the report runs
 on, on the field benchmark packed on its wall (scenarios/bench/field_wall_*.toml), by `floedem
 bench --stages` with FLOEDEM_THREADS set; and the check that the thread count changes nothing:
 the same field run on 1 thread and on every core, in colour order (the benchmark's

@@ -1,4 +1,4 @@
-"""Towing forces (MODEL.md section 6): the paper's case (scenarios/towing_paper.toml) on every
+"""Towing forces (docs/model.md section 6): the paper's case (scenarios/towing_paper.toml) on every
 engine, its statistics, the domain check, the concentration and speed sweeps against the
 momentum-flux estimate, the restitution sensitivity, and free drift in ice against open water.
 
@@ -171,7 +171,7 @@ class Case:
 
 
 def momentum_flux(case, e, v):
-    """MODEL.md 6: (1 + e) rho_i h C W v^2, the momentum the swept ice takes per second."""
+    """docs/model.md 6: (1 + e) rho_i h C W v^2, the momentum the swept ice takes per second."""
     return (1.0 + e) * case.density * case.thickness * case.concentration * case.width * v * v
 
 
@@ -285,7 +285,7 @@ def write(ctx):
                         key=lambda k: k.concentration)
     speed_cases = sorted([(SPEED, base)] + [(v, Case(ctx.run(f"towing_v{v:g}"), c["s_stat"], rel)) for v in c["speeds"]])
     md += ["### Concentration and speed against the momentum-flux estimate", "",
-           "MODEL.md 6: the iceberg sweeps ice of mass rho_i h C W per metre; bringing it to the towing speed costs "
+           "docs/model.md 6: the iceberg sweeps ice of mass rho_i h C W per metre; bringing it to the towing speed costs "
            "F_a = (1 + e) rho_i h C W v^2. It leaves out the ice pushed ahead and aside, which is dragged through the "
            "water and rubs on its neighbours, so the simulated force is expected above it; the ratio shows by how much.",
            "", "![sweeps](fig/towing_sweeps.png)", "",

@@ -217,7 +217,7 @@ void BM_DragTerms(benchmark::State& state) {
 }
 BENCHMARK(BM_DragTerms)->Args({0, 1000})->Args({1, 1000})->Args({0, 16000})->Args({1, 16000})->Unit(benchmark::kMicrosecond);
 
-/// Field generation (issue 4's targets: 1e4 floes under 2 s, 1e5 under 20 s on 2 cores):
+/// Field generation (the speed targets: 1e4 floes under 2 s, 1e5 under 20 s on 2 cores):
 /// alpha 2, d 2..50 m, C 0.5, default irregularity; the square domain holds N floes.
 void BM_FieldGenerator(benchmark::State& state) {
   FieldSpec s;

@@ -190,7 +190,7 @@ double number(const std::map<std::string, std::string>& row, const std::string& 
 }  // namespace
 
 TEST_CASE("cli: no heap allocation in the steady state of a packed field", "[cli][allocations]") {
-  // Issue 8: "no allocation per step in the steady state (checked)". The 1k field of the speed
+  // "no allocation per step in the steady state (checked)". The 1k field of the speed
   // benchmark is packed on its wall after about 100 s; over the last 50 s of 200, every list a
   // step uses has reached its size, so `floedem bench` (which counts malloc and its kin, and
   // operator new under a sanitizer) must count none, on one thread and on two (the pool's

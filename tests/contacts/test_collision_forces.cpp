@@ -1,4 +1,4 @@
-// Collision forces from impulses (MODEL.md section 4): effective mass, duration, mean and peak
+// Collision forces from impulses (docs/model.md section 4): effective mass, duration, mean and peak
 // force of the half-sine pulse, and how events are told apart, against closed forms.
 //
 // Tolerances: the formulas are evaluated on the solver's impulse, which is exact to the

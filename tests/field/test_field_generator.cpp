@@ -1,4 +1,4 @@
-// The broken-ice field generator (MODEL.md section 5): concentration, power-law exponent, no
+// The broken-ice field generator (docs/model.md section 5): concentration, power-law exponent, no
 // overlap (decided exactly), inside the domain, reproducible, keep-out zones, bad input.
 //
 // Tolerances (from the issue, and why they are physical): concentration within 0.005 (a
@@ -6,7 +6,7 @@
 // within 0.02 (a tenth of the scatter of exponents fitted to aerial images, 1.5 to 3.5).
 // The method makes both exact up to round-off and the exponent up to the discreteness of N
 // stratified sizes, far inside those bounds, so the tests also check the much tighter values
-// the method reaches (1e-9 and 2e-3), so that a regression shows long before the issue's bounds.
+// the method reaches (1e-9 and 2e-3), so that a regression shows long before the required bounds.
 #include <catch2/catch.hpp>
 
 #include <functional>

@@ -1,4 +1,4 @@
-// Environmental forcing against closed forms (issue 3). Each tolerance is stated with its reason.
+// Environmental forcing against closed forms. Each tolerance is stated with its reason.
 #include <catch2/catch.hpp>
 
 #include <complex>
@@ -46,7 +46,7 @@ TEST_CASE("Coriolis only: the inertial circle closes after 10 periods at dt = 60
   const double radius = length(v0) / f;
   const double error = std::hypot(e->state().position[0].x - z.real(), e->state().position[0].y - z.imag());
   INFO("radius " << radius << " m, error " << error << " m");
-  // 1e-4 of the radius is the issue's bound; the scheme's own error is (f dt)^2 / 24 ~ 3e-6.
+  // 1e-4 of the radius is the required bound; the scheme's own error is (f dt)^2 / 24 ~ 3e-6.
   CHECK(error < 1e-4 * radius);
   // The speed never changes: the turn per step is an exact rotation.
   CHECK(length(e->state().velocity[0]) == Approx(length(v0)).epsilon(1e-12));
@@ -75,7 +75,7 @@ TEST_CASE("quadratic drag towards a steady current follows the closed-form 1-D s
     CHECK(std::abs(e->state().angular_velocity[0]) < 1e-15);  // symmetric: no torque
   }
   INFO("worst error " << worst << " m/s, time scale m / (K U) = " << m / (k * u) << " s");
-  // 1e-4 of U: the issue's bound; the linearly implicit step errs by ~dt / (2 tau) ~ 6e-5.
+  // 1e-4 of U: the required bound; the linearly implicit step errs by ~dt / (2 tau) ~ 6e-5.
   CHECK(worst < 1e-4 * u);
 }
 
@@ -99,7 +99,7 @@ TEST_CASE("Coriolis plus linear drag reaches the analytic steady drift", "[envir
   const Vec2 jv = cross(1.0, current);
   const Vec2 steady = (a / (a * a + f * f)) * (a * current - f * jv);
   INFO("steady (" << steady.x << ", " << steady.y << "), got (" << e->state().velocity[0].x << ", " << e->state().velocity[0].y << ")");
-  // 1e-6 m/s: the issue's bound. The scheme's steady state is exact up to (f dt)^2 / 12 ~ 4e-8
+  // 1e-6 m/s: the required bound. The scheme's steady state is exact up to (f dt)^2 / 12 ~ 4e-8
   // relative, and 30 000 s is 17 drag time scales m / K, so the transient is below 1e-7.
   CHECK(length(e->state().velocity[0] - steady) < 1e-6);
 }

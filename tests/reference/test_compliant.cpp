@@ -1,5 +1,5 @@
 // Compliant reference contacts (contact_model = "compliant"): a collision lasts, and its
-// measured duration is held against the linear spring-dashpot's closed forms (MODEL.md 4).
+// measured duration is held against the linear spring-dashpot's closed forms (docs/model.md 4).
 //
 // For a spring k and dashpot of damping ratio zeta on the effective mass, a contact that
 // cannot pull lets go at t_c = (pi - atan(2 zeta sqrt(1 - zeta^2) / (1 - 2 zeta^2))) / omega_d,

@@ -1,4 +1,4 @@
-// The CI cross-checks (issue 5): the standard impact suite on every engine, against the
+// The CI cross-checks: the standard impact suite on every engine, against the
 // closed forms and against the native solver. Tolerance 0.1 % unless an engine cannot reach
 // it; each such gap is stated below with its measured size and cause.
 #include <catch2/catch.hpp>
@@ -69,7 +69,7 @@ TEST_CASE("cross-engine: half-overlapping faces", "[cross]") {
   for (const char* engine : kEngines) {
     INFO(engine);
     const Outcome o = run(engine, text, kImpactSteps);
-    CHECK(o.impulse_on_b == Approx(42545.5).epsilon(1e-3));  // exact 2-D answer (shared notes)
+    CHECK(o.impulse_on_b == Approx(42545.5).epsilon(1e-3));  // exact 2-D answer (docs/engines.md)
     for (int i = 0; i < 2; ++i) {
       CHECK(o.state.velocity[i].x == Approx(ref.state.velocity[i].x).margin(1e-3));
       CHECK(o.state.velocity[i].y == Approx(ref.state.velocity[i].y).margin(1e-3));
@@ -190,7 +190,7 @@ TEST_CASE("cross-engine: ODE and Bullet stay in the plane over 1e4 steps", "[cro
   for (const char* engine : {"bullet", "ode"}) {
     INFO(engine);
     const Outcome o = run(engine, text, 10000);
-    CHECK(o.max_out_of_plane < 1e-6);  // m and rad: the issue's bound
+    CHECK(o.max_out_of_plane < 1e-6);  // m and rad: the required bound
   }
 }
 

@@ -1,4 +1,4 @@
-// The stress suite's figures (issue 9): what run_scene reports about penetration, speed and
+// The stress suite's figures: what run_scene reports about penetration, speed and
 // energy, and the stress cases native is shown to hold in the report, held here for every build.
 #include <catch2/catch.hpp>
 

@@ -177,7 +177,7 @@ TEST_CASE("head-on impact of equal squares: restitution, momentum and energy exa
     const After r = run_one_step(c, coloured);
     const double va = r.state.velocity[0].x, vb = r.state.velocity[1].x;
     // Achieved restitution: separation speed over approach speed; the tolerance 1e-9 is the
-    // issue's, far above round-off (1e-16) and far below any physical meaning.
+    // requirement, far above round-off (1e-16) and far below any physical meaning.
     CHECK(std::abs((vb - va) / 1.0 - e) <= 1e-9);
     // Momentum m (va + vb) = m * 1: to 1e-12 relative.
     CHECK(std::abs(va + vb - 1.0) <= 1e-12);
@@ -211,7 +211,7 @@ TEST_CASE("half-overlapping faces: two-point impact against the closed form", "[
   double j = 0.0;
   for (const auto& k : r.contacts) j += k.normal_impulse;
   CHECK(j == Approx(want.pn[0] + want.pn[1]).epsilon(1e-6));
-  CHECK(j == Approx(42545.5).margin(0.1));  // the exact 2-D answer in shared/notes/reference-engines.md
+  CHECK(j == Approx(42545.5).margin(0.1));  // the exact 2-D answer in docs/engines.md
   check_momentum(v0, generalised(r.state), {5, 5}, {15, 10});
 }
 
@@ -227,7 +227,7 @@ TEST_CASE("face on corner, without friction, sticking and sliding", "[impact]") 
   };
   const Case cases[] = {
       {0.0, {1.0, 0.0}, 0.0, "frictionless"},
-      {0.3, {1.0, 0.0}, 0.0, "sticking (the shared notes' case)"},
+      {0.3, {1.0, 0.0}, 0.0, "sticking (docs/engines.md)"},
       {0.05, {1.0, 0.0}, 0.0, "sliding"},
       {0.1, {1.0, 0.6}, 0.05, "oblique, spinning, sliding"},
       {0.8, {1.0, 0.6}, 0.05, "oblique, spinning, sticking"},
@@ -251,7 +251,7 @@ TEST_CASE("face on corner, without friction, sticking and sliding", "[impact]") 
     CHECK(rec.tangent_impulse == Approx(want.pt[0]).margin(1e-6 * want.pn[0]));
     // Coulomb: inside the cone, and on its edge only when sliding.
     CHECK(std::abs(rec.tangent_impulse) <= k.mu * rec.normal_impulse * (1 + 1e-12));
-    if (k.mu == 0.0) CHECK(rec.normal_impulse == Approx(52232.1).margin(0.1));  // shared notes
+    if (k.mu == 0.0) CHECK(rec.normal_impulse == Approx(52232.1).margin(0.1));  // docs/engines.md
     if (k.mu == 0.3) {
       // Shared notes: vA = (0.40493, -0.05493), omega_B = -0.02330 (given to 5 digits).
       CHECK(r.state.velocity[0].x == Approx(0.40493).margin(1e-5));

@@ -31,7 +31,7 @@ TEST_CASE("a floe pushed against a fixed wall: force equals the push, no jitter"
     worst_speed = std::max(worst_speed, length(e->state().velocity[0]));
     worst_spin = std::max(worst_spin, std::abs(e->state().angular_velocity[0]) * 5.0);
   }
-  // 0.1 % is the bound: a resting contact must carry the load, not bounce under it.
+  // 0.1 % is the required bound: a resting contact must carry the load, not bounce under it.
   CHECK(worst_force <= 1e-3);
   // 1e-9 m/s: round-off of F dt / m = 2.2e-3 m/s times a few ulps; any jitter would be far larger.
   CHECK(worst_speed < 1e-9);

@@ -1,4 +1,4 @@
-// Towing against closed forms (issue 3).
+// Towing against closed forms.
 #include <catch2/catch.hpp>
 
 #include <H5Cpp.h>
@@ -37,7 +37,7 @@ TEST_CASE("towing at constant speed in calm open water: the towing force is the 
   for (int n = 0; n < 200; ++n) {
     run.step();
     const TowMonitor& tow = run.tow();
-    // 1e-6 relative: the issue's bound; both sides are the same closed form up to round-off.
+    // 1e-6 relative: the required bound; both sides are the same closed form up to round-off.
     CHECK(tow.force().x == Approx(drag_at(0.7)).epsilon(1e-6));
     CHECK(std::abs(tow.force().y) < 1e-9 * drag_at(0.7));
   }
@@ -86,7 +86,7 @@ TEST_CASE("rope towing in steady state: the rope carries the drag", "[tow]") {
   Stepper run(s, "native");
   for (int n = 0; n < 30000; ++n) run.step();
   const TowMonitor& tow = run.tow();
-  // 1e-4 relative: the issue's bound. 30 000 s is ~20 drag time scales m_I / (K v).
+  // 1e-4 relative: the required bound. 30 000 s is ~20 drag time scales m_I / (K v).
   CHECK(tow.force().x == Approx(drag_at(0.5)).epsilon(1e-4));
   CHECK(run.state().velocity[0].x == Approx(0.5).epsilon(1e-4));
   CHECK(std::abs(run.state().angle[0]) < 1e-9);  // pulled from ahead of its centroid: stays on course
