@@ -23,6 +23,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 from report_runner import run_all  # noqa: E402
 from sections import SECTIONS  # noqa: E402
+from sections.speed import load_stage_labels  # noqa: E402
 
 
 class Context:
@@ -87,6 +88,7 @@ def main():
     listed = [line.split("\t")[0] for line in floedem_text(a.floedem, "engines").splitlines() if line.strip()]
     engines = ["native"] + [e for e in listed if e != "native"]
     ctx = Context(a, engines)
+    load_stage_labels(a.floedem)
     for d in (ctx.fig, ctx.runs_dir):
         shutil.rmtree(d, ignore_errors=True)   # nothing in the report may come from an earlier run
         os.makedirs(d)

@@ -12,6 +12,7 @@
 #include "app/field_command.hpp"
 #include "app/python_script.hpp"
 #include "engine/registry.hpp"
+#include "engine/step_stages.hpp"
 #include "io/recorder.hpp"
 #include "run/resume.hpp"
 #include "run/simulation.hpp"
@@ -86,6 +87,8 @@ int main(int argc, char** argv) {
       throw CLI::RequiredError("a scenario file, or --resume RESULT.h5,");
   });
   CLI::App* list = app.add_subcommand("engines", "list the engines this build has");
+  CLI::App* stage_list = app.add_subcommand(
+      "stages", "list the stages of a step on the native engine, in order, as `floedem bench --stages` names them");
 
   std::string report_out = "results/report";
   bool report_quick = false;
@@ -116,6 +119,10 @@ int main(int argc, char** argv) {
   try {
     if (list->parsed()) {
       for (const auto& e : floedem::engines()) std::cout << e.name << "\t" << e.description << "\n";
+      return 0;
+    }
+    if (stage_list->parsed()) {
+      for (const auto& s : floedem::kStepStages) std::cout << s.name << "\t" << s.label << "\t" << s.what << "\n";
       return 0;
     }
     if (field->parsed()) return floedem::run_field_command(field_options);

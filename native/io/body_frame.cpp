@@ -4,23 +4,11 @@
 
 #include <filesystem>
 
+#include "io/h5_read.hpp"
 #include "scene/input_error.hpp"
 
 namespace floedem {
 namespace {
-
-template <class T>
-std::vector<T> read_all(H5::H5File& f, const std::string& name, const H5::DataType& type, std::vector<hsize_t>& dims) {
-  H5::DataSet ds = f.openDataSet(name);
-  H5::DataSpace space = ds.getSpace();
-  dims.assign(static_cast<std::size_t>(space.getSimpleExtentNdims()), 0);
-  space.getSimpleExtentDims(dims.data());
-  hsize_t count = 1;
-  for (const hsize_t d : dims) count *= d;
-  std::vector<T> out(count);
-  if (count > 0) ds.read(out.data(), type);
-  return out;
-}
 
 /// Rows [row, row + 1) of a dataset [T, rest...].
 std::vector<double> read_row(H5::H5File& f, const std::string& name, hsize_t row, std::vector<hsize_t>& dims) {

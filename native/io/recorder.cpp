@@ -398,6 +398,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
 
 void Recorder::write_run_attributes(const Scene& scene, const RunInfo& run) {
   H5::Group root = impl_->file.openGroup("/");
+  write_number_attribute(root, "format_version", H5::PredType::NATIVE_INT64, kOutputFormatVersion);
   write_attribute(root, "floedem_version", run.floedem_version);
   write_attribute(root, "scenario", scene.source_text);
   write_attribute(root, "scenario_path", scene.source_path);
@@ -502,6 +503,12 @@ StoredRun read_stored_run(const std::string& path) {
     run.scenario = read_string_attribute(root, "scenario");
     if (run.engine.empty() || run.scenario.empty() || !f.nameExists("/bodies/mass"))
       throw InputError(path + ": not a floedem run's output (no engine, scenario or /bodies/mass)");
+    std::int64_t format = 0;  // files written before the attribute existed: layout 0, refused below
+    if (root.attrExists("format_version"))
+      root.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
+    if (format != kOutputFormatVersion)
+      throw InputError(path + ": format_version " + std::to_string(format) + ", this floedem reads " +
+                       std::to_string(kOutputFormatVersion) + (format > kOutputFormatVersion ? " (a newer floedem wrote it)" : " (an older floedem wrote it)"));
     run.status = read_string_attribute(root, "status");
     run.floedem_version = read_string_attribute(root, "floedem_version");
     run.scenario_path = read_string_attribute(root, "scenario_path");

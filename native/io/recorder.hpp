@@ -1,5 +1,5 @@
 #pragma once
-// HDF5 output of a run (layout in README.md, "Output"). Written as the run goes, under
+// HDF5 output of a run (layout in docs/output.md). Written as the run goes, under
 // RESULT.h5.partial, in chunks fixed by the data (so the bytes do not depend on the run's
 // speed), HDF5 flushed whenever a buffer is written, so that a killed run keeps what it wrote
 // readable; renamed to RESULT.h5 by finish() only. Checkpoints (/checkpoint, two slots
@@ -18,6 +18,13 @@
 #include "towing/tow.hpp"
 
 namespace floedem {
+
+/// The output layout's version, the root attribute `format_version` of every file floedem writes
+/// (runs and fields). It rises by one whenever a change would make a reader of the last layout
+/// misread a file: a dataset or attribute removed or renamed, or its unit, shape, type or meaning
+/// changed. Adding a dataset or an attribute leaves it as it is (readers ignore what they do not
+/// know). A reader refuses a file of a higher version than its own (docs/output.md).
+inline constexpr std::int64_t kOutputFormatVersion = 1;
 
 /// Output could not be written (unwritable directory, disk full, ...). Exit code 3.
 class OutputError : public std::runtime_error {

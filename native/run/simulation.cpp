@@ -291,30 +291,33 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                    {"contact_work", summary.contact_work},
                    {"max_relative_energy_gain", summary.max_relative_energy_gain}});
   // No wall time in the file: two runs of one scene give bit-identical files.
+  summary.headline = read_run_headline(options.output);
   return summary;
 }
 
 std::string format_summary(const Scene& scene, const RunSummary& s, const std::string& output) {
   std::size_t fixed = 0;
   for (const auto& b : scene.bodies) fixed += b.fixed ? 1 : 0;
-  char buf[1024];
-  std::snprintf(buf, sizeof buf,
+  char head[1024], tail[1024];
+  std::snprintf(head, sizeof head,
                 "floedem run: %s on %s\n"
                 "  bodies      %zu (%zu fixed)\n"
                 "  steps       %lld (dt %g s, %g s of model time), %lld frames recorded\n"
                 "  impulses    %lld collision, %lld resting (%lld contact rows recorded)\n"
-                "  collisions  %lld events, largest peak force %.4g N\n"
-                "  kinetic energy %.6g J -> %.6g J; fastest body %.4g m/s\n"
-                "  wall time   %.3f s (%.4f ms per step)\n"
-                "  output      %s\n",
+                "  collisions  %lld events\n",
                 scene.source_path.c_str(), s.engine.c_str(), scene.bodies.size(), fixed,
                 static_cast<long long>(s.steps), scene.run.dt, static_cast<double>(s.steps) * scene.run.dt,
                 static_cast<long long>(s.frames), static_cast<long long>(s.collision_impulses),
                 static_cast<long long>(s.resting_impulses), static_cast<long long>(s.contact_rows),
-                static_cast<long long>(s.collision_events), s.max_peak_force,
+                static_cast<long long>(s.collision_events));
+  std::snprintf(tail, sizeof tail,
+                "  kinetic energy %.6g J -> %.6g J; fastest body %.4g m/s\n"
+                "  wall time   %.3f s (%.4f ms per step)\n"
+                "  output      %s\n",
                 s.kinetic_energy_start, s.kinetic_energy_end, s.max_speed, s.wall_seconds,
                 1e3 * s.wall_seconds / static_cast<double>(std::max<std::int64_t>(s.steps, 1)), output.c_str());
-  return buf;
+  // The headline figures (the tow, the loads, the largest collision) between the counts and the cost.
+  return head + format_run_headline(s.headline) + tail;
 }
 
 }  // namespace floedem

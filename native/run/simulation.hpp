@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "io/run_headline.hpp"
 #include "scene/scene.hpp"
 
 namespace floedem {
@@ -51,6 +52,7 @@ struct RunSummary {
   double contact_work = 0.0;
   double max_relative_energy_gain = 0.0;
   double wall_seconds = 0.0;
+  RunHeadline headline;  ///< read back from the finished file: tow, loads, largest collision
 };
 
 /// Runs the scene and writes its output; throws InputError (bad engine settings, before any

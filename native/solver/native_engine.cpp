@@ -1,13 +1,6 @@
-// The native planar non-smooth DEM. One step, in order (NativeEngine::step):
-//   1. pairs      bounds fattened by each body's reach this step -> coherent broad phase (pair_cache)
-//   2. manifolds  narrow phase per pair, impulses carried over by feature id, contacts classified
-//   3. forces     non-contact loads change velocities (symplectic Euler: v* = v + dt M^-1 F)
-//   4. solve      contact impulses at velocity level (contact_solver.cpp); heavy-light islands
-//                 that Gauss-Seidel leaves approaching get their normals solved directly
-//                 (island_solve.cpp)
-//   5. integrate  x += dt v+, angle += dt w+
-//   6. project    overlap beyond the allowed penetration removed on positions only
-//   7. record     contact impulses of the step, for the recorder
+// The native planar non-smooth DEM. One step (NativeEngine::step) makes the stages of
+// engine/step_stages.hpp from broad_phase to record, in that list's order; docs/architecture.md
+// describes what each reads and writes.
 #include "solver/native_engine.hpp"
 
 #include <algorithm>
@@ -18,6 +11,7 @@
 
 #include "engine/line_vector.hpp"
 #include "engine/prefetch.hpp"
+#include "engine/step_stages.hpp"
 #include "solver/broad_phase.hpp"
 #include "solver/pair_cache.hpp"
 #include "solver/contact_islands.hpp"
@@ -50,11 +44,9 @@ constexpr std::size_t kManifoldWriteBytes = 320;
 
 /// What the next step's contact list reads of one of this step's contacts: its pair, and each
 /// point's feature id, kind and accumulated impulses (persistence and the warm start). 56 bytes
-/// in a list of their own, written by record() as it reads the impulses: the contact list had
-/// read them from the last step's 384-byte manifolds, 320 bytes each (at 10^5 floes some 50 MB
-/// a step, from memory), and that list was kept a step for them alone. Measured at 100k floes
-/// (side by side): the contact list 13.2 -> 10.7 ms a step, the record 4.9 -> 6.1, peak memory
-/// 892 -> 819 MB; the same values carried, so the same results to the bit.
+/// in a list of their own, written by record() as it reads the impulses, so that the contact
+/// list need not read 320 bytes of each of the last step's 384-byte manifolds (at 10^5 floes
+/// some 50 MB a step, from memory) nor keep that list a step for them alone.
 struct CarriedContact {
   std::int32_t part_a = 0, part_b = 0;
   std::uint32_t id[2] = {};
@@ -107,12 +99,13 @@ class NativeEngine final : public Engine {
   NativeSettings settings_;
   ContactSettings contact_;
   double dt_;
-  // Wall time per stage of step(), when asked for (floedem bench); in step()'s order.
+  // Wall time per stage of step(), when asked for (floedem bench): the stages of
+  // engine/step_stages.hpp from broad_phase to record, in step()'s order.
   enum Stage : std::size_t {
     kBroad, kNarrow, kContactList, kLoads, kSolve, kRedetect, kIntegrate, kProject, kRecord, kStages
   };
-  StageClock<kStages> stages_{{"broad_phase", "narrow_phase", "contact_list", "loads", "contact_solve", "redetect",
-                               "integrate", "position_projection", "record"}};
+  static_assert(step_stage("record") - step_stage("broad_phase") + 1 == kStages);
+  StageClock<kStages> stages_{step_stage_names<kStages>(step_stage("broad_phase"))};
 
   // Hot: touched every step.
   BodyArrays bodies_;

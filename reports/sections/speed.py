@@ -1,10 +1,10 @@
-"""Speed (issue 8): wall time per step of the field benchmark (scenarios/bench/field_wall_*.toml:
+"""Speed: wall time per step of the field benchmark (scenarios/bench/field_wall_*.toml:
 floes 5-30 m at 50 % drifting onto a wall until nearly every floe touches another) and of the
 paper's towing case, on every engine, by `floedem bench`: one run at a time after all other runs
 of the report, one process per run, the median over the timed window (the packed state), with
 allocations per step and peak memory. The 16k field's native and Box2D runs are timed again in
 the other order (config's `again`), and its targets are judged on every round. Each run's CSV row is in runs/TAG.csv and all rows in
-bench.csv. The issue's targets are shown against what was measured; they are goals for the
+bench.csv. The speed targets are shown against what was measured; they are goals for the
 solver, not agreement checks, so a target missed is reported here and is not a disagreement.
 
 Penetration is shown beside the time: an engine that is faster by letting floes overlap more
@@ -15,6 +15,7 @@ field (iterations and dt per engine: cost against mean overlap). Every run here 
 threaded; the thread count is the threads section's."""
 import csv
 import os
+import subprocess
 
 from report_runner import Run
 
@@ -150,13 +151,18 @@ def stages(row):
     return out
 
 
-# The stages as the report names them (native/solver/native_engine.cpp, NativeEngine::step, and
-# the forcing and towing of native/run/stepper.cpp), in the order of a step.
-STAGE_LABELS = {"forcing": "forcing (environment terms)", "broad_phase": "broad phase", "narrow_phase": "narrow phase",
-                "contact_list": "contact list (warm start, classify)", "loads": "loads",
-                "contact_solve": "contact solve (islands, sweeps)", "redetect": "redetect",
-                "integrate": "integrate", "position_projection": "position projection", "record": "record",
-                "towing": "towing"}
+# The stages of a native step as the report names them, in the order of a step: filled once from
+# `floedem stages` (native/engine/step_stages.hpp, the one list) by load_stage_labels.
+STAGE_LABELS = {}
+
+
+def load_stage_labels(floedem):
+    """Fills STAGE_LABELS ({name: label}, in order) from `floedem stages`."""
+    out = subprocess.run([floedem, "stages"], capture_output=True, text=True, check=True).stdout
+    STAGE_LABELS.clear()
+    for line in out.splitlines():
+        name, label, _ = line.split("\t", 2)
+        STAGE_LABELS[name] = label
 
 
 def stages_section(ctx, rows, every):
@@ -327,13 +333,13 @@ def round_ratios(rows, again, scene, engine, size=None):
 
 
 def targets(rows, again):
-    """The issue's targets against what this report measured. The 16k field's: each engine's
+    """The speed targets against what this report measured. The 16k field's: each engine's
     speed ratio in every round that timed it (the lowest decides) and the penetration beside it
     (the issue asks equal or smaller)."""
     def ms(tag):
         return float(rows[tag]["median_ms"]) if tag in rows else None
 
-    out = ["Issue 8's targets, as measured here:", ""]
+    out = ["The speed targets, as measured here:", ""]
 
     def versus(scene, targets, label, size=None):
         # With `size` (the field): every round, and the penetration beside the speed.
@@ -425,7 +431,7 @@ def cost_against_error(ctx, every):
     md = ["Run time against error: the 1 000-floe field with the iterations and the step swept on every engine "
           "(labels: iterations / dt). The error is the mean overlap of the overlapping contact points over the "
           "timed window, the constraint violation a contact solver is there to remove; the cost is wall time per "
-          "0.05 s of model time (so that steps of different length compare). The issue's other error measures "
+          "0.05 s of model time (so that steps of different length compare). The other error measures "
           "(impact against Newton's law, free drift against its closed form, the towing force against a converged "
           "run) are in the next section, \"Run time against error\".", "",
           "| engine | points | beaten by a native point (cheaper and no worse) | least error (mm) | its cost (ms) |",

@@ -3,6 +3,7 @@
 
 #include <H5Cpp.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 
 #include "io/recorder.hpp"
 #include "run/simulation.hpp"
+#include "scene/input_error.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -54,6 +56,9 @@ TEST_CASE("output layout: bodies, frames, contacts, attributes", "[output]") {
   CHECK(string_attribute(f.openGroup("/"), "scenario") == kScene);
   CHECK(string_attribute(f.openGroup("/"), "overrides") == "run.output_every=10");
   CHECK_FALSE(string_attribute(f.openGroup("/"), "floedem_version").empty());
+  std::int64_t format = 0;
+  f.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
+  CHECK(format == kOutputFormatVersion);
   double dt = 0;
   f.openAttribute("dt").read(H5::PredType::NATIVE_DOUBLE, &dt);
   CHECK(dt == 0.01);
@@ -149,7 +154,7 @@ TEST_CASE("an unwritable output directory is an output error, and nothing is lef
 TEST_CASE("/loads: a floe pressed on a wall by the current loads it with the floe's drag", "[output][loads]") {
   // A 10 m square floe, 1 m thick, at rest against a fixed wall, a 0.5 m/s current towards the
   // wall: in equilibrium the wall carries the water drag on the floe at rest,
-  // 1/2 rho_w C_w W d u^2 + rho_w C_dw A u^2 with draft d = h rho_i / rho_w (MODEL.md 2).
+  // 1/2 rho_w C_w W d u^2 + rho_w C_dw A u^2 with draft d = h rho_i / rho_w (docs/model.md 2).
   const std::string text =
       "[run]\nduration = 60.0\ndt = 0.1\noutput_every = 600\n[output]\ncontacts = \"none\"\nloads = [\"wall\"]\n"
       "load_every = 10\n[environment]\ncurrent = [-0.5, 0.0]\n"
@@ -175,4 +180,78 @@ TEST_CASE("/loads: a floe pressed on a wall by the current loads it with the flo
   CHECK(v[2 * (dims[0] - 1)] == Approx(-drag).epsilon(1e-6));  // the floe pushes the wall along -x
   CHECK(v[2 * (dims[0] - 1) + 1] == Approx(0.0).margin(1e-6 * drag));
   fs::remove(out);
+}
+
+TEST_CASE("run summary: the headline figures are the file's means over the second half", "[output][loads]") {
+  // The floe of the test above, drifting 1 m onto the wall first: a collision, then the floe
+  // pressed. The headline's load is the mean of the /loads rows that start at or after 30 s,
+  // reduced here by hand from the file, and is the drag in equilibrium; its largest collision is
+  // the largest row of /contacts/collisions.
+  const std::string text =
+      "[run]\nduration = 60.0\ndt = 0.1\noutput_every = 600\n[output]\ncontacts = \"none\"\nloads = [\"wall\"]\n"
+      "load_every = 10\n[environment]\ncurrent = [-0.5, 0.0]\n"
+      "[[body]]\nname = \"wall\"\npolygon = [[-5,-20],[0,-20],[0,20],[-5,20]]\nthickness = 5.0\nfixed = true\n"
+      "[[body]]\nname = \"floe\"\npolygon = [[1,-5],[11,-5],[11,5],[1,5]]\nthickness = 1.0\nvelocity = [-0.5, 0.0]\n";
+  const Scene s = test::scene_from(text);
+  const fs::path out = fs::temp_directory_path() / ("floedem-headline-" + std::to_string(::getpid()) + ".h5");
+  RunOptions o;
+  o.output = out.string();
+  const RunSummary sum = run_scene(s, o);
+  const RunHeadline& h = sum.headline;
+  CHECK(h.window_start == 30.0);
+  CHECK(h.window_end == Approx(60.0));
+  CHECK_FALSE(h.tow);
+  REQUIRE(h.loads.size() == 1);
+  CHECK(h.loads[0].body == "wall");
+
+  H5::H5File f(out.string(), H5F_ACC_RDONLY);
+  std::vector<double> time(60), force(120);
+  f.openDataSet("/loads/time").read(time.data(), H5::PredType::NATIVE_DOUBLE);
+  f.openDataSet("/loads/force").read(force.data(), H5::PredType::NATIVE_DOUBLE);
+  double fx = 0.0, fy = 0.0;
+  int rows = 0;
+  for (std::size_t i = 1; i < time.size(); ++i)
+    if (time[i - 1] >= 30.0 - 1e-9) fx += force[2 * i], fy += force[2 * i + 1], ++rows;
+  CHECK(rows == 30);  // rows of equal span: the weighted mean is the plain one
+  CHECK(h.loads[0].force.x == Approx(fx / rows).epsilon(1e-12));
+  CHECK(h.loads[0].force.y == Approx(fy / rows).margin(1e-9));
+  const double draft = 1.0 * 900.0 / 1025.0;
+  const double drag = 0.5 * 1025.0 * 0.9 * 10.0 * draft * 0.25 + 1025.0 * 5e-4 * 100.0 * 0.25;
+  CHECK(h.loads[0].force.x == Approx(-drag).epsilon(1e-6));
+
+  H5::DataSet peak = f.openDataSet("/contacts/collisions/peak_force");
+  std::vector<double> peaks(static_cast<std::size_t>(peak.getSpace().getSimpleExtentNpoints()));
+  REQUIRE_FALSE(peaks.empty());
+  peak.read(peaks.data(), H5::PredType::NATIVE_DOUBLE);
+  REQUIRE(h.largest_collision);
+  CHECK(h.largest_collision->peak_force == *std::max_element(peaks.begin(), peaks.end()));
+  CHECK(h.largest_collision->body_a == "wall");
+  CHECK(h.largest_collision->body_b == "floe");
+  CHECK(h.largest_collision->time < 5.0);  // 1 m at 0.5 m/s
+  const std::string text_summary = format_summary(s, sum, out.string());
+  CHECK(text_summary.find("load        wall, mean over t = 30 to 60 s") != std::string::npos);
+  CHECK(text_summary.find("the largest of any collision: wall and floe") != std::string::npos);
+  fs::remove(out);
+}
+
+TEST_CASE("a run's output of another format_version is refused, naming the file and both versions", "[output]") {
+  const fs::path dir = test::temp_dir("format");
+  const std::string out = (dir / "r.h5").string();
+  RunOptions o;
+  o.output = out;
+  run_scene(test::scene_from(kScene), o);
+  {
+    H5::H5File f(out, H5F_ACC_RDWR);
+    const std::int64_t newer = kOutputFormatVersion + 1;
+    f.openAttribute("format_version").write(H5::PredType::NATIVE_INT64, &newer);
+  }
+  try {
+    read_stored_run(out);
+    FAIL("a newer format was read");
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    CHECK(m.find(out) == 0);
+    CHECK(m.find("format_version " + std::to_string(kOutputFormatVersion + 1)) != std::string::npos);
+    CHECK(m.find("a newer floedem wrote it") != std::string::npos);
+  }
 }

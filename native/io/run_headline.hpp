@@ -1,0 +1,45 @@
+#pragma once
+// The figures a run's summary leads with, read back from its finished output file: what an
+// engineer asks of the run first. Read from the file rather than tallied during the run, so
+// that a run continued with --resume (whose earlier rows are only in the file) gives the same
+// figures as one never interrupted.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/vec2.hpp"
+
+namespace floedem {
+
+struct RunHeadline {
+  /// s: the tow and load means are over the rows from here to the end (the second half of
+  /// the run, where a towing or a pressed pack has settled: the rows whose interval starts at
+  /// or after half the run's time).
+  double window_start = 0.0;
+  double window_end = 0.0;
+  struct Tow {
+    std::string body;
+    Vec2 force;      ///< N, mean towing force
+    Vec2 ice_force;  ///< N, its ice part (minus the contact force on the towed body)
+  };
+  std::optional<Tow> tow;
+  struct Load {
+    std::string body;
+    Vec2 force;  ///< N, mean contact force on the body
+  };
+  std::vector<Load> loads;  ///< the bodies of [output] loads
+  struct Collision {
+    double peak_force = 0.0;  ///< N
+    double time = 0.0;        ///< s, end of the impact step
+    std::string body_a, body_b;
+  };
+  std::optional<Collision> largest_collision;  ///< the collision event of the largest peak force
+};
+
+/// Reads the headline figures of a complete run's output. Throws InputError naming the file.
+RunHeadline read_run_headline(const std::string& path);
+
+/// The headline as summary lines (empty when the run has none of them).
+std::string format_run_headline(const RunHeadline& h);
+
+}  // namespace floedem
