@@ -5,7 +5,7 @@ figure and table is made here from the runs made here. Exit status: 0 when the e
 within the documented tolerances, 5 when they do not (each disagreement printed, the report
 written all the same), 4 when a run failed (no report written).
 
-`floedem report [--quick] [--out DIR]` runs this (the README's main job).
+`floedem report [--quick] [--out DIR]` runs this (the main job runs the quick one).
 
 usage: report.py [--floedem build/floedem] [--out results/report] [--quick] [--jobs N] [--only S,...]
 """

@@ -38,7 +38,7 @@ def iterations(engine, count):
 def config(quick):
     # again: the field size whose native and Box2D runs are timed a second time, in the other
     # order, right after the first round: a virtual machine's speed drifts (by up to 1.7x within
-    # an hour, README "Speed"), and the 16k ratio is a target, so it is taken from two pairs of
+    # an hour: docs/performance.md), and the 16k ratio is a target, so it is taken from two pairs of
     # adjacent runs (native, box2d ... box2d, native), not from one.
     if quick:   # a smoke run of the machinery: the field is not packed yet at 40 s
         return dict(field=[("1k", 40.0, 20.0)], again="1k", towing=(60.0, 30.0),
