@@ -9,6 +9,8 @@ import csv
 import os
 import sys
 
+from sections.speed import stages  # the stage_ms column, read as the report reads it
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 LATEST = os.path.join(HERE, "latest")
@@ -85,14 +87,6 @@ def read(name):
     path = os.path.join(LATEST, name)
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
-
-
-def stages(row):
-    out = {}
-    for item in (row.get("stage_ms") or "").split():
-        k, _, v = item.partition("=")
-        out[k] = float(v)
-    return out
 
 
 def plain(row):

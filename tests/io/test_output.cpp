@@ -37,6 +37,22 @@ const std::string kScene = test::header_toml(1.0, 0.01, 0.3, 0.3, "[engine.nativ
                            test::body_toml({"a", test::box({5, 5}, 10, 10), {1.0, 0.0}}) +
                            test::body_toml({"b", {{10.5, 0}, {20.5, 0}, {10.5, 12}}, {}, 0.1});
 
+/// A 10 m square floe, 1 m thick, and a fixed wall at x = 0, a 0.5 m/s current towards the
+/// wall, 60 s at dt 0.1 s; the wall's load recorded every 10 steps.
+std::string wall_and_floe(const std::string& floe_polygon, const std::string& floe_velocity) {
+  return "[run]\nduration = 60.0\ndt = 0.1\noutput_every = 600\n[output]\ncontacts = \"none\"\nloads = [\"wall\"]\n"
+         "load_every = 10\n[environment]\ncurrent = [-0.5, 0.0]\n"
+         "[[body]]\nname = \"wall\"\npolygon = [[-5,-20],[0,-20],[0,20],[-5,20]]\nthickness = 5.0\nfixed = true\n"
+         "[[body]]\nname = \"floe\"\npolygon = " + floe_polygon + "\nthickness = 1.0\nvelocity = " + floe_velocity + "\n";
+}
+
+/// N: the water drag on that floe at rest, which the wall carries in equilibrium:
+/// 1/2 rho_w C_w W d u^2 + rho_w C_dw A u^2 with draft d = h rho_i / rho_w (docs/model.md 2).
+double wall_load() {
+  const double draft = 1.0 * 900.0 / 1025.0;
+  return 0.5 * 1025.0 * 0.9 * 10.0 * draft * 0.25 + 1025.0 * 5e-4 * 100.0 * 0.25;
+}
+
 }  // namespace
 
 TEST_CASE("output layout: bodies, frames, contacts, attributes", "[output]") {
@@ -152,15 +168,8 @@ TEST_CASE("an unwritable output directory is an output error, and nothing is lef
 }
 
 TEST_CASE("/loads: a floe pressed on a wall by the current loads it with the floe's drag", "[output][loads]") {
-  // A 10 m square floe, 1 m thick, at rest against a fixed wall, a 0.5 m/s current towards the
-  // wall: in equilibrium the wall carries the water drag on the floe at rest,
-  // 1/2 rho_w C_w W d u^2 + rho_w C_dw A u^2 with draft d = h rho_i / rho_w (docs/model.md 2).
-  const std::string text =
-      "[run]\nduration = 60.0\ndt = 0.1\noutput_every = 600\n[output]\ncontacts = \"none\"\nloads = [\"wall\"]\n"
-      "load_every = 10\n[environment]\ncurrent = [-0.5, 0.0]\n"
-      "[[body]]\nname = \"wall\"\npolygon = [[-5,-20],[0,-20],[0,20],[-5,20]]\nthickness = 5.0\nfixed = true\n"
-      "[[body]]\nname = \"floe\"\npolygon = [[0,-5],[10,-5],[10,5],[0,5]]\nthickness = 1.0\n";
-  const Scene s = test::scene_from(text);
+  // The floe at rest against the wall: in equilibrium the wall carries its drag (wall_load).
+  const Scene s = test::scene_from(wall_and_floe("[[0,-5],[10,-5],[10,5],[0,5]]", "[0.0, 0.0]"));
   const fs::path out = fs::temp_directory_path() / ("floedem-loads-" + std::to_string(::getpid()) + ".h5");
   RunOptions o;
   o.output = out.string();
@@ -175,8 +184,7 @@ TEST_CASE("/loads: a floe pressed on a wall by the current loads it with the flo
   CHECK(dims[1] == 1);
   std::vector<double> v(dims[0] * 2);
   force.read(v.data(), H5::PredType::NATIVE_DOUBLE);
-  const double draft = 1.0 * 900.0 / 1025.0;
-  const double drag = 0.5 * 1025.0 * 0.9 * 10.0 * draft * 0.25 + 1025.0 * 5e-4 * 100.0 * 0.25;
+  const double drag = wall_load();
   CHECK(v[2 * (dims[0] - 1)] == Approx(-drag).epsilon(1e-6));  // the floe pushes the wall along -x
   CHECK(v[2 * (dims[0] - 1) + 1] == Approx(0.0).margin(1e-6 * drag));
   fs::remove(out);
@@ -187,12 +195,7 @@ TEST_CASE("run summary: the headline figures are the file's means over the secon
   // pressed. The headline's load is the mean of the /loads rows that start at or after 30 s,
   // reduced here by hand from the file, and is the drag in equilibrium; its largest collision is
   // the largest row of /contacts/collisions.
-  const std::string text =
-      "[run]\nduration = 60.0\ndt = 0.1\noutput_every = 600\n[output]\ncontacts = \"none\"\nloads = [\"wall\"]\n"
-      "load_every = 10\n[environment]\ncurrent = [-0.5, 0.0]\n"
-      "[[body]]\nname = \"wall\"\npolygon = [[-5,-20],[0,-20],[0,20],[-5,20]]\nthickness = 5.0\nfixed = true\n"
-      "[[body]]\nname = \"floe\"\npolygon = [[1,-5],[11,-5],[11,5],[1,5]]\nthickness = 1.0\nvelocity = [-0.5, 0.0]\n";
-  const Scene s = test::scene_from(text);
+  const Scene s = test::scene_from(wall_and_floe("[[1,-5],[11,-5],[11,5],[1,5]]", "[-0.5, 0.0]"));
   const fs::path out = fs::temp_directory_path() / ("floedem-headline-" + std::to_string(::getpid()) + ".h5");
   RunOptions o;
   o.output = out.string();
@@ -215,8 +218,7 @@ TEST_CASE("run summary: the headline figures are the file's means over the secon
   CHECK(rows == 30);  // rows of equal span: the weighted mean is the plain one
   CHECK(h.loads[0].force.x == Approx(fx / rows).epsilon(1e-12));
   CHECK(h.loads[0].force.y == Approx(fy / rows).margin(1e-9));
-  const double draft = 1.0 * 900.0 / 1025.0;
-  const double drag = 0.5 * 1025.0 * 0.9 * 10.0 * draft * 0.25 + 1025.0 * 5e-4 * 100.0 * 0.25;
+  const double drag = wall_load();
   CHECK(h.loads[0].force.x == Approx(-drag).epsilon(1e-6));
 
   H5::DataSet peak = f.openDataSet("/contacts/collisions/peak_force");
