@@ -39,8 +39,9 @@ page. A test fails when the page and the CSVs disagree.
 - **Ratios, not absolute times**, between engines or builds, from runs made side by side on the
   same machine, and repeated: `floedem report` times the 16k field twice, the second round in
   the reverse order of engines, and counts a speed target as met only when both pairs of
-  adjacent runs show it. On a shared virtual machine a median moves by 10 to 20 % between
-  rounds minutes apart, and a ratio belongs to the machine it was measured on.
+  adjacent runs show it. On a shared virtual machine a median moves between rounds minutes
+  apart (below, the committed report's two rounds), and a ratio belongs to the machine it was
+  measured on.
 - **The stage clock** (`--stages`) reads the clock twice a stage: nothing against a field's
   milliseconds, so the report times stages on the field and towing runs only.
 - **Equal iterations**: the field benchmark (`scenarios/bench/`) gives every engine dt = 0.05 s
@@ -130,6 +131,20 @@ def speed_table(rows):
     return md
 
 
+def rounds(rows):
+    """How far the same engine's median moved between the rounds of a case timed twice."""
+    out = []
+    for scen in dict.fromkeys(r["scenario"] for r in rows):
+        for e in ENGINES:
+            ms = [float(r["median_ms"]) for r in rows
+                  if r["scenario"] == scen and r["engine"] == e and plain(r) and r["threads"] == "1"]
+            if len(ms) >= 2:
+                out.append(f"{e} {fmt(ms[0])} and {fmt(ms[1])} ms ({100 * abs(ms[1] - ms[0]) / min(ms):.0f} %)")
+        if out:
+            return [f"Round to round on `{scen}`, minutes apart: " + ", ".join(out) + ".", ""]
+    return []
+
+
 def penetration_table(rows):
     md = ["| case | " + " | ".join(ENGINES) + " |", "|---|" + "---|" * len(ENGINES)]
     seen = []
@@ -204,6 +219,7 @@ def render():
           "wall). Where a case was timed twice, both rounds are given; each speed-up is against the native run "
           "made next to it:", ""]
     md += speed_table(bench) + [""]
+    md += rounds(bench)
     md += ["Deepest penetration over the same windows (mm):", ""] + penetration_table(bench) + [""]
     md += ["Where native's step goes (mean ms a step by stage, single thread; the stages of "
            "[architecture.md](architecture.md)):", ""] + stage_table(bench) + [""]
