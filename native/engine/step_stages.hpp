@@ -1,7 +1,7 @@
 #pragma once
 // The stages of one step of a run on the native engine, in the order a step makes them: the one
 // list that the stage clocks (Stepper, NativeEngine), `floedem bench --stages` (the stage_ms
-// column), `floedem bench --list-stages`, the report's speed section and docs/architecture.md
+// column), `floedem stages`, the report's speed section and docs/architecture.md
 // all name. A new stage is one line here and one StageClock::time call where it runs; the test
 // `docs: the stages of architecture.md are the code's` holds the document to this list.
 #include <array>
@@ -24,7 +24,7 @@ inline constexpr std::array<StepStage, 11> kStepStages{{
      "each pair's contact manifold by separating axes and clipping, up to two points with feature ids"},
     {"contact_list", "contact list (warm start, classify)",
      "manifolds with contacts, last step's impulses carried by feature id, each point a collision or resting"},
-    {"loads", "loads", "the forcing's loads change the velocities (drag implicit, Coriolis an exact turn)"},
+    {"loads", "loads", "the forcing's loads change the velocities"},
     {"contact_solve", "contact solve (islands, sweeps)",
      "impulses island by island: Gauss-Seidel with the exact local law, NNCG, direct solve of heavy-light islands"},
     {"redetect", "redetect",
