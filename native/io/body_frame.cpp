@@ -60,14 +60,7 @@ BodyFrame read_body_frame(const std::string& path, std::int64_t frame) {
     step = "read /bodies/fixed";
     out.fixed = read_all<std::uint8_t>(f, "/bodies/fixed", H5::PredType::NATIVE_UINT8, dims);
     step = "read /bodies/name";
-    {
-      H5::DataSet ds = f.openDataSet("/bodies/name");
-      H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-      std::vector<char*> raw(n, nullptr);
-      if (n > 0) ds.read(raw.data(), type);
-      for (char* s : raw) out.names.emplace_back(s ? s : "");
-      if (n > 0) H5Dvlen_reclaim(type.getId(), ds.getSpace().getId(), H5P_DEFAULT, raw.data());
-    }
+    out.names = read_strings(f, "/bodies/name");
     step = "read /time";
     const auto times = read_all<double>(f, "/time", H5::PredType::NATIVE_DOUBLE, dims);
     const auto frames = static_cast<std::int64_t>(times.size());
@@ -86,7 +79,8 @@ BodyFrame read_body_frame(const std::string& path, std::int64_t frame) {
     const auto vel = read_row(f, "/bodies/velocity", static_cast<hsize_t>(k), dims);
     step = "read /bodies/angular_velocity";
     out.angular_velocity = read_row(f, "/bodies/angular_velocity", static_cast<hsize_t>(k), dims);
-    if (out.thickness.size() != n || out.density.size() != n || out.fixed.size() != n || pos.size() != 2 * n ||
+    if (out.names.size() != n || out.thickness.size() != n || out.density.size() != n || out.fixed.size() != n ||
+        pos.size() != 2 * n ||
         ang.size() != n || vel.size() != 2 * n || out.angular_velocity.size() != n ||
         (n > 0 && static_cast<std::size_t>(offsets.back()) * 2 != vertices.size()))
       throw InputError(path + ": /bodies datasets disagree on the number of bodies or vertices; not a floedem file?");

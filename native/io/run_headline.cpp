@@ -11,19 +11,6 @@
 namespace floedem {
 namespace {
 
-std::vector<std::string> read_names(H5::H5File& f) {
-  H5::DataSet ds = f.openDataSet("/bodies/name");
-  const hsize_t n = static_cast<hsize_t>(ds.getSpace().getSimpleExtentNpoints());
-  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-  type.setCset(H5T_CSET_UTF8);  // as the recorder writes them
-  std::vector<char*> raw(n, nullptr);
-  if (n > 0) ds.read(raw.data(), type);
-  std::vector<std::string> out;
-  for (char* s : raw) out.emplace_back(s ? s : "");
-  if (n > 0) H5Dvlen_reclaim(type.getId(), ds.getSpace().getId(), H5P_DEFAULT, raw.data());
-  return out;
-}
-
 std::string name_of(const std::vector<std::string>& names, std::int64_t k) {
   return k >= 0 && static_cast<std::size_t>(k) < names.size() ? names[static_cast<std::size_t>(k)]
                                                                : "body " + std::to_string(k);
@@ -74,7 +61,7 @@ RunHeadline read_run_headline(const std::string& path) {
     h.window_end = frames.empty() ? 0.0 : frames.back();
     h.window_start = 0.5 * h.window_end;
     step = "read /bodies/name";
-    const std::vector<std::string> names = read_names(f);
+    const std::vector<std::string> names = read_strings(f, "/bodies/name");
 
     if (f.nameExists("/tow")) {
       step = "read /tow";
