@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "geometry/polygon.hpp"
-#include "geometry/vec2.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem::test {
 

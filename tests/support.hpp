@@ -1,5 +1,6 @@
 #pragma once
 // Helpers shared by the tests: scenes from TOML text, engines, polygons as TOML.
+#include <catch2/catch.hpp>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "engine/registry.hpp"
+#include "floedem/engine/registry.hpp"
 #include "floe_polygon.hpp"
 #include "forcing/force_term.hpp"
-#include "scenario/scenario.hpp"
+#include "floedem/scenario/scenario.hpp"
 
 namespace floedem::test {
 
@@ -46,6 +47,15 @@ inline std::filesystem::path temp_dir(const std::string& name) {
 
 inline Scene scene_from(const std::string& toml, const std::vector<std::string>& overrides = {}) {
   return parse_scenario(toml, "test.toml", overrides);
+}
+
+/// True when this build has the engine (FLOEDEM_WITH_ODE, _BULLET, _BOX2D); otherwise a
+/// warning naming it, and the caller skips what needs it.
+inline bool have_engine(const std::string& name) {
+  for (const auto& e : engines())
+    if (e.name == name) return true;
+  WARN("skipped: this build has no " << name << " engine");
+  return false;
 }
 
 inline std::unique_ptr<Engine> native(const Scene& s) { return make_engine("native", s); }

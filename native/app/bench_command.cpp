@@ -15,11 +15,11 @@
 #include "app/allocation_count.hpp"
 #include "io/recorder.hpp"
 #include "parallel/threads.hpp"
-#include "run/simulation.hpp"
+#include "floedem/run/simulation.hpp"
 #include "run/stepper.hpp"
-#include "scenario/scenario.hpp"
-#include "scene/input_error.hpp"
-#include "version.hpp"
+#include "floedem/scenario/scenario.hpp"
+#include "floedem/scene/input_error.hpp"
+#include "floedem/version.hpp"
 
 namespace floedem {
 
@@ -181,7 +181,7 @@ int run_bench_command(const BenchCommand& c) {
   for (const std::string& o : c.overrides) overrides += (overrides.empty() ? "" : " ") + o;
   std::ostringstream row;
   row.precision(6);
-  row << field(host_name()) << ',' << field(cpu_model()) << ',' << worker_threads() << ',' << field(kFloedemVersion) << ','
+  row << field(host_name()) << ',' << field(cpu_model()) << ',' << worker_threads() << ',' << field(version()) << ','
       << field(std::filesystem::path(c.scenario).filename().string()) << ',' << field(overrides) << ',' << c.engine << ','
       << field(stepper.engine().info().version) << ',' << scene.bodies.size() << ',' << moving << ',' << scene.run.dt << ','
       << steps << ',' << timed << ',' << percentile(ms, 0.5) << ',' << mean << ',' << percentile(ms, 0.1) << ','

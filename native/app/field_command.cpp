@@ -7,9 +7,9 @@
 #include <iostream>
 #include <sstream>
 
-#include "field/field_file.hpp"
-#include "scene/input_error.hpp"
-#include "version.hpp"
+#include "floedem/field/field_file.hpp"
+#include "floedem/scene/input_error.hpp"
+#include "floedem/version.hpp"
 
 namespace floedem {
 namespace {
@@ -103,7 +103,7 @@ int run_field_command(FieldCommand& c) {
     throw InputError(flag_of(e.parameter()) + ": " + e.what());
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_field_file(c.out, field, c.spec, c.density, std::string(kFloedemVersion));
+  write_field_file(c.out, field, c.spec, c.density, std::string(version()));
   if (!c.quiet) {
     const FieldStats& s = field.stats;
     std::printf("%s: %zu floes, concentration %.6f (target %.6f), alpha fitted %.4f +- %.4f (target %.4f), %.2f s\n",

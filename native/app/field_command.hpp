@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "field/field_generator.hpp"
+#include "floedem/field/field_generator.hpp"
 
 namespace floedem {
 

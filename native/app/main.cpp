@@ -11,14 +11,14 @@
 #include "app/bench_command.hpp"
 #include "app/field_command.hpp"
 #include "app/python_script.hpp"
-#include "engine/registry.hpp"
+#include "floedem/engine/registry.hpp"
 #include "engine/step_stages.hpp"
 #include "io/recorder.hpp"
-#include "run/resume.hpp"
-#include "run/simulation.hpp"
-#include "scenario/scenario.hpp"
-#include "scene/input_error.hpp"
-#include "version.hpp"
+#include "floedem/run/resume.hpp"
+#include "floedem/run/simulation.hpp"
+#include "floedem/scenario/scenario.hpp"
+#include "floedem/scene/input_error.hpp"
+#include "floedem/version.hpp"
 
 namespace {
 
@@ -55,7 +55,10 @@ int resume_command(const std::string& path, const std::vector<std::string>& over
 
 int main(int argc, char** argv) {
   CLI::App app{"floedem: planar non-smooth DEM of icebergs drifting or towed through broken sea ice"};
-  app.set_version_flag("--version", std::string(floedem::kFloedemVersion));
+  // The library's version and the output layout it writes and reads, as a run's file stores them
+  // (root attributes floedem_version and format_version).
+  app.set_version_flag("--version", "floedem " + std::string(floedem::version()) + " (output format_version " +
+                                        std::to_string(floedem::kOutputFormatVersion) + ")");
   app.require_subcommand(1);
 
   std::string scenario, engine = "native", output;

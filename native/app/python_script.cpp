@@ -17,7 +17,13 @@ int run_python_script(const std::string& script, const std::vector<std::string>&
               << " needs Python 3 with numpy, h5py and matplotlib, which the build did not find\n";
     return -1;
   }
-  std::vector<std::string> all{python, std::string(FLOEDEM_REPORTS_DIR) + "/" + script};
+  const std::string dir = data_dir();
+  if (dir.empty()) {
+    std::cerr << "floedem: error: cannot find share/floedem (the report's scripts) beside " << own_executable()
+              << " or above it; install with `cmake --install` or run the command from its build directory\n";
+    return -1;
+  }
+  std::vector<std::string> all{python, dir + "/reports/" + script};
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : all) argv.push_back(a.data());
@@ -31,6 +37,15 @@ int run_python_script(const std::string& script, const std::vector<std::string>&
   waitpid(pid, &status, 0);
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+std::string data_dir() {
+  namespace fs = std::filesystem;
+  const fs::path bin = fs::path(own_executable()).parent_path();
+  std::error_code ec;
+  for (const fs::path& d : {bin / "share" / "floedem", bin.parent_path() / "share" / "floedem"})
+    if (fs::is_directory(d / "reports", ec)) return d.string();
+  return {};
 }
 
 std::string own_executable() {

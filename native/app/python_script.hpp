@@ -6,9 +6,13 @@
 
 namespace floedem {
 
-/// Runs reports/SCRIPT with the arguments, waits for it; its output goes to ours. Returns its
+/// Runs share/floedem/reports/SCRIPT with the arguments, waits for it; its output goes to ours. Returns its
 /// exit status, or -1 with a message on stderr when Python is missing or cannot start.
 int run_python_script(const std::string& script, const std::vector<std::string>& args);
+
+/// share/floedem (the report's scripts and the scenarios), found from this executable's path:
+/// BIN/share/floedem in the build tree, BIN/../share/floedem installed; empty when neither is.
+std::string data_dir();
 
 /// This executable's own path (for scripts that call floedem back).
 std::string own_executable();

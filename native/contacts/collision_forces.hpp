@@ -22,8 +22,8 @@
 #include <utility>
 #include <vector>
 
-#include "engine/engine.hpp"
-#include "scene/scene.hpp"
+#include "floedem/engine/engine.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

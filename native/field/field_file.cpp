@@ -1,8 +1,8 @@
-#include "field/field_file.hpp"
+#include "floedem/field/field_file.hpp"
 
 #include <sstream>
 
-#include "engine/engine.hpp"
+#include "floedem/engine/engine.hpp"
 #include "io/recorder.hpp"
 
 namespace floedem {

@@ -1,4 +1,4 @@
-#include "field/field_generator.hpp"
+#include "floedem/field/field_generator.hpp"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>

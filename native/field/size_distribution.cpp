@@ -1,4 +1,4 @@
-#include "field/size_distribution.hpp"
+#include "floedem/field/size_distribution.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -12,8 +12,8 @@
 #include <string_view>
 #include <vector>
 
-#include "engine/engine.hpp"
-#include "scene/scene.hpp"
+#include "floedem/engine/engine.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

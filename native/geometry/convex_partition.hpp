@@ -4,7 +4,7 @@
 #include <span>
 #include <vector>
 
-#include "geometry/vec2.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
 

@@ -170,4 +170,22 @@ std::vector<Vec2> inset_convex(const std::vector<Vec2>& poly, double distance) {
   return out;
 }
 
+std::optional<std::string> polygon_problem(std::span<const Vec2> poly) {
+  if (poly.size() < 3) return "has " + std::to_string(poly.size()) + " vertices; allowed at least 3";
+  if (poly.size() > kMaxPolygonVertices)
+    return "has " + std::to_string(poly.size()) + " vertices; allowed at most " + std::to_string(kMaxPolygonVertices);
+  for (std::size_t k = 0; k < poly.size(); ++k)
+    if (!(std::abs(poly[k].x) <= kLargestCoordinate && std::abs(poly[k].y) <= kLargestCoordinate))
+      return "vertex " + std::to_string(k) + " lies beyond 1e7 m; allowed |x|, |y| <= 1e7 m";
+  if (const auto hit = find_self_intersection(poly))
+    return "is self-intersecting (edges " + std::to_string(hit->first) + " and " + std::to_string(hit->second) +
+           " touch or cross, counting from 0); allowed a simple polygon";
+  const double a = signed_area(poly);
+  const Aabb box = bounds_of(poly);
+  const double box_area = (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y);
+  if (!(std::abs(a) > 1e-12 * box_area) || box_area == 0.0)
+    return std::string("has zero area; allowed a simple polygon of positive area");
+  return std::nullopt;
+}
+
 }  // namespace floedem

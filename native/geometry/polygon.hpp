@@ -2,10 +2,11 @@
 // Plane polygon geometry: area, centroid, polar moment, convexity and simplicity checks.
 #include <optional>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
-#include "geometry/vec2.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
 
@@ -33,6 +34,20 @@ bool is_strictly_convex(std::span<const Vec2> poly);
 /// Indices (i, j) of two non-adjacent edges (edge k runs from vertex k to k+1) that touch
 /// or cross, or of a repeated vertex; nullopt for a simple polygon. O(n^2): polygons are small.
 std::optional<std::pair<std::size_t, std::size_t>> find_self_intersection(std::span<const Vec2> poly);
+
+/// The checks of a body's outline, the same wherever it is read (a scenario's polygon, a field
+/// file's or a run's /bodies/polygon_vertices): at least 3 and at most kMaxPolygonVertices
+/// vertices, each within kLargestCoordinate of the origin in x and y, no self-intersection, an
+/// area above round-off. Returns why the polygon fails, as words that follow its name ("has 2
+/// vertices; allowed at least 3"), or nullopt when it passes. Either orientation passes.
+std::optional<std::string> polygon_problem(std::span<const Vec2> poly);
+
+/// Coordinates within 1e7 m (ten thousand kilometres, beyond any ice field): far larger ones
+/// are typing errors or damage, and they break the convex partition's arithmetic (a vertex at
+/// 4e75 m crashed CGAL's optimal partition).
+inline constexpr double kLargestCoordinate = 1e7;
+/// The self-intersection check is O(n^2): a floe or iceberg outline has tens of vertices.
+inline constexpr std::size_t kMaxPolygonVertices = 10000;
 
 /// Removes repeated vertices and vertices on the straight line between their neighbours
 /// (within a relative tolerance). Keeps the order.

@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "geometry/lanes4.hpp"
-#include "geometry/vec2.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
 

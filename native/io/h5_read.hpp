@@ -1,7 +1,11 @@
 #pragma once
-// Whole-dataset reads shared by floedem's HDF5 readers (io/*.cpp only: it includes H5Cpp.h).
+// Reading floedem's HDF5 files (io/*.cpp only: it includes H5Cpp.h). read_all and read_strings
+// read files floedem has just written itself; CheckedFile reads files a user gives (a field
+// file, a run's output as a field, a run to resume), checking each dataset and attribute before
+// it is used, so that a damaged or foreign file is an InputError of one line, never a crash.
 #include <H5Cpp.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,17 +27,45 @@ std::vector<T> read_all(H5::H5File& f, const std::string& name, const H5::DataTy
 
 /// Every string of a 1-D dataset of variable-length UTF-8 strings (as the recorder writes
 /// /bodies/name).
-inline std::vector<std::string> read_strings(H5::H5File& f, const std::string& name) {
-  H5::DataSet ds = f.openDataSet(name);
-  const auto n = static_cast<std::size_t>(ds.getSpace().getSimpleExtentNpoints());
-  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-  type.setCset(H5T_CSET_UTF8);
-  std::vector<char*> raw(n, nullptr);
-  if (n > 0) ds.read(raw.data(), type);
-  std::vector<std::string> out;
-  for (char* s : raw) out.emplace_back(s ? s : "");
-  if (n > 0) H5Dvlen_reclaim(type.getId(), ds.getSpace().getId(), H5P_DEFAULT, raw.data());
-  return out;
-}
+std::vector<std::string> read_strings(H5::H5File& f, const std::string& name);
+
+/// A file given by the user, read with every check. Each failure throws InputError
+/// "LABEL: WHAT: PROBLEM" (LABEL: the file's path). Shapes are given as extents, -1 for any.
+class CheckedFile {
+ public:
+  CheckedFile(H5::H5File& file, std::string label) : file_(file), label_(std::move(label)) {}
+
+  [[noreturn]] void fail(const std::string& what, const std::string& problem) const;
+  /// True when the object (a group or dataset, absolute path) exists, its parents too.
+  bool exists(const std::string& path) const;
+
+  /// The root attribute format_version, which must be this floedem's kOutputFormatVersion.
+  void check_format_version() const;
+  /// A scalar string attribute of the root; empty when absent and !required.
+  std::string text_attribute(const std::string& name, bool required) const;
+  /// A scalar numeric attribute of `object` (a group or dataset path).
+  double real_attribute(const std::string& object, const std::string& name) const;
+  std::int64_t integer_attribute(const std::string& object, const std::string& name) const;
+  std::uint64_t unsigned_attribute(const std::string& object, const std::string& name) const;
+
+  /// A float dataset of this shape, every value finite; its shape in `dims`.
+  std::vector<double> reals(const std::string& name, const std::vector<std::int64_t>& shape, std::vector<hsize_t>& dims) const;
+  /// Row `row` of a float dataset [rows, shape...], every value finite.
+  std::vector<double> real_row(const std::string& name, const std::vector<std::int64_t>& shape, hsize_t row) const;
+  /// An integer dataset of this shape, read as int64 (bytes: uint8).
+  std::vector<std::int64_t> integers(const std::string& name, const std::vector<std::int64_t>& shape, std::vector<hsize_t>& dims) const;
+  std::vector<std::uint8_t> bytes(const std::string& name, const std::vector<std::int64_t>& shape) const;
+  /// A 1-D dataset of n strings.
+  std::vector<std::string> strings(const std::string& name, std::int64_t n) const;
+
+  const std::string& label() const { return label_; }
+
+ private:
+  H5::DataSet open(const std::string& name, H5T_class_t type_class, const std::vector<std::int64_t>& shape,
+                   std::vector<hsize_t>& dims) const;
+  H5::Attribute scalar_attribute(const std::string& object, const std::string& name, H5T_class_t type_class) const;
+  H5::H5File& file_;
+  std::string label_;
+};
 
 }  // namespace floedem

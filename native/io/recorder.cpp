@@ -9,8 +9,9 @@
 #include <cstring>
 #include <filesystem>
 
-#include "engine/state_io.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/engine/state_io.hpp"
+#include "floedem/scene/input_error.hpp"
+#include "floedem/version.hpp"
 
 namespace floedem {
 
@@ -133,16 +134,12 @@ hsize_t frame_chunk_of(std::size_t bodies) {
   return std::clamp<hsize_t>(65536 / per_frame, 1, 4096);
 }
 
-/// The checksum of a checkpoint slot: its bytes and its step (a slot whose step attribute
-/// was written without its bytes, or the reverse, fails it).
+}  // namespace
+
 std::uint64_t slot_checksum(std::int64_t step, const std::vector<std::uint8_t>& state) {
   std::uint64_t h = state_checksum(state.data(), state.size());
   return h ^ state_checksum(reinterpret_cast<const std::uint8_t*>(&step), sizeof step);
 }
-
-constexpr const char* kCheckpointSlots[2] = {"/checkpoint/slot_a", "/checkpoint/slot_b"};
-
-}  // namespace
 
 struct Recorder::Impl {
   H5::H5File file;
@@ -480,72 +477,6 @@ RecordedRows Recorder::rows() const {
 }
 
 std::int64_t Recorder::frame_chunk() const { return static_cast<std::int64_t>(impl_->frame_chunk); }
-
-namespace {
-std::string read_string_attribute(const H5::H5Object& o, const std::string& name) {
-  if (!o.attrExists(name)) return {};
-  const H5::Attribute a = o.openAttribute(name);
-  std::string v;
-  a.read(a.getStrType(), v);
-  return v;
-}
-}  // namespace
-
-StoredRun read_stored_run(const std::string& path) {
-  H5::Exception::dontPrint();
-  if (!std::filesystem::exists(path)) throw InputError(path + ": no such file");
-  StoredRun run;
-  try {
-    if (!H5::H5File::isHdf5(path)) throw InputError(path + ": not an HDF5 file (a floedem run's output is)");
-    H5::H5File f(path, H5F_ACC_RDONLY);
-    const H5::Group root = f.openGroup("/");
-    run.engine = read_string_attribute(root, "engine");
-    run.scenario = read_string_attribute(root, "scenario");
-    if (run.engine.empty() || run.scenario.empty() || !f.nameExists("/bodies/mass"))
-      throw InputError(path + ": not a floedem run's output (no engine, scenario or /bodies/mass)");
-    std::int64_t format = 0;  // files written before the attribute existed: layout 0, refused below
-    if (root.attrExists("format_version"))
-      root.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
-    if (format != kOutputFormatVersion)
-      throw InputError(path + ": format_version " + std::to_string(format) + ", this floedem reads " +
-                       std::to_string(kOutputFormatVersion) + (format > kOutputFormatVersion ? " (a newer floedem wrote it)" : " (an older floedem wrote it)"));
-    run.status = read_string_attribute(root, "status");
-    run.floedem_version = read_string_attribute(root, "floedem_version");
-    run.scenario_path = read_string_attribute(root, "scenario_path");
-    if (root.attrExists("duration")) root.openAttribute("duration").read(H5::PredType::NATIVE_DOUBLE, &run.duration);
-    const std::string overrides = read_string_attribute(root, "overrides");
-    for (std::size_t at = 0; at < overrides.size();) {
-      const std::size_t end = std::min(overrides.find('\n', at), overrides.size());
-      if (end > at) run.overrides.push_back(overrides.substr(at, end - at));
-      at = end + 1;
-    }
-    H5::DataSet mass = f.openDataSet("/bodies/mass");
-    run.mass.resize(static_cast<std::size_t>(mass.getSpace().getSimpleExtentNpoints()));
-    if (!run.mass.empty()) mass.read(run.mass.data(), H5::PredType::NATIVE_DOUBLE);
-    for (const char* name : kCheckpointSlots) {
-      if (!f.nameExists("/checkpoint") || !f.nameExists(name)) continue;
-      H5::DataSet slot = f.openDataSet(name);
-      StoredCheckpoint c;
-      std::uint64_t checksum = 0;
-      if (!slot.attrExists("step") || !slot.attrExists("checksum")) {
-        ++run.damaged_slots;
-        continue;
-      }
-      slot.openAttribute("step").read(H5::PredType::NATIVE_INT64, &c.step);
-      slot.openAttribute("checksum").read(H5::PredType::NATIVE_UINT64, &checksum);
-      c.state.resize(static_cast<std::size_t>(slot.getSpace().getSimpleExtentNpoints()));
-      if (!c.state.empty()) slot.read(c.state.data(), H5::PredType::NATIVE_UINT8);
-      if (slot_checksum(c.step, c.state) != checksum) {
-        ++run.damaged_slots;
-        continue;
-      }
-      if (!run.checkpoint || c.step > run.checkpoint->step) run.checkpoint = std::move(c);
-    }
-  } catch (const H5::Exception& e) {
-    throw InputError(path + ": cannot read the run's file (" + e.getDetailMsg() + ")");
-  }
-  return run;
-}
 
 void Recorder::check_space(const Scene& scene) const {
   // The frames' size is known before the run: 6 doubles per body and frame (position, angle,

@@ -13,24 +13,12 @@
 #include <vector>
 
 #include "contacts/collision_forces.hpp"
-#include "engine/engine.hpp"
-#include "scene/scene.hpp"
+#include "floedem/engine/engine.hpp"
+#include "floedem/io/output.hpp"
+#include "floedem/scene/scene.hpp"
 #include "towing/tow.hpp"
 
 namespace floedem {
-
-/// The output layout's version, the root attribute `format_version` of every file floedem writes
-/// (runs and fields). It rises by one whenever a change would make a reader of the last layout
-/// misread a file: a dataset or attribute removed or renamed, or its unit, shape, type or meaning
-/// changed. Adding a dataset or an attribute leaves it as it is (readers ignore what they do not
-/// know). A reader refuses a file of a higher version than its own (docs/output.md).
-inline constexpr std::int64_t kOutputFormatVersion = 1;
-
-/// Output could not be written (unwritable directory, disk full, ...). Exit code 3.
-class OutputError : public std::runtime_error {
- public:
-  explicit OutputError(const std::string& m) : std::runtime_error(m) {}
-};
 
 struct RunInfo {
   std::vector<std::string> forcing_terms;
@@ -43,24 +31,12 @@ struct RecordedRows {
   std::int64_t frames = 0, contacts = 0, collisions = 0, tow = 0, loads = 0;
 };
 
-/// A checkpoint read back from a run's file: the newest of the two slots whose checksum holds.
-struct StoredCheckpoint {
-  std::int64_t step = 0;
-  std::vector<std::uint8_t> state;
-};
+/// The two checkpoint datasets, written in turn.
+inline constexpr const char* kCheckpointSlots[2] = {"/checkpoint/slot_a", "/checkpoint/slot_b"};
 
-/// What `floedem run --resume` needs from a run's file (root attributes and checkpoint).
-struct StoredRun {
-  std::string status, engine, floedem_version, scenario, scenario_path;
-  std::vector<std::string> overrides;
-  double duration = 0.0;     ///< s, run.duration of the run as written
-  std::vector<double> mass;  ///< /bodies/mass: the scene rebuilt must have the same bodies
-  std::optional<StoredCheckpoint> checkpoint;
-  int damaged_slots = 0;     ///< checkpoint slots with a wrong checksum (cut short by a kill)
-};
-
-/// Reads a run's file; InputError when it is missing or not a floedem run.
-StoredRun read_stored_run(const std::string& path);
+/// The checksum of a checkpoint slot: its bytes and its step (a slot whose step attribute
+/// was written without its bytes, or the reverse, fails it).
+std::uint64_t slot_checksum(std::int64_t step, const std::vector<std::uint8_t>& state);
 
 class Recorder {
  public:

@@ -1,4 +1,4 @@
-#include "io/run_headline.hpp"
+#include "floedem/io/run_headline.hpp"
 
 #include <H5Cpp.h>
 
@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "io/h5_read.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/scene/input_error.hpp"
 
 namespace floedem {
 namespace {

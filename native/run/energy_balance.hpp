@@ -20,8 +20,8 @@
 #include <span>
 #include <vector>
 
-#include "engine/engine.hpp"
-#include "scene/scene.hpp"
+#include "floedem/engine/engine.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

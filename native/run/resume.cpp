@@ -1,13 +1,13 @@
-#include "run/resume.hpp"
+#include "floedem/run/resume.hpp"
 
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 
 #include "io/recorder.hpp"
-#include "scenario/scenario.hpp"
-#include "scene/input_error.hpp"
-#include "version.hpp"
+#include "floedem/scenario/scenario.hpp"
+#include "floedem/scene/input_error.hpp"
+#include "floedem/version.hpp"
 
 namespace floedem {
 
@@ -62,11 +62,11 @@ ResumeResult resume_run(const std::string& path, const std::vector<std::string>&
                      " s); nothing to continue (a longer run: --set run.duration=T)";
     return result;
   }
-  if (run.floedem_version != kFloedemVersion)
+  if (run.floedem_version != version())
     std::fprintf(stderr,
                  "floedem: warning: %s was written by floedem %s, this is %s: the continuation is exact only with "
                  "the same build\n",
-                 stored.c_str(), run.floedem_version.c_str(), kFloedemVersion);
+                 stored.c_str(), run.floedem_version.c_str(), version());
 
   RunOptions options;
   options.engine = run.engine;

@@ -1,4 +1,4 @@
-#include "run/simulation.hpp"
+#include "floedem/run/simulation.hpp"
 
 #include <unistd.h>
 
@@ -15,8 +15,8 @@
 #include "io/recorder.hpp"
 #include "run/energy_balance.hpp"
 #include "run/stepper.hpp"
-#include "scene/input_error.hpp"
-#include "version.hpp"
+#include "floedem/scene/input_error.hpp"
+#include "floedem/version.hpp"
 
 namespace floedem {
 
@@ -137,7 +137,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   Stepper stepper(scene, options.engine);
   RunInfo info;
   for (const auto name : stepper.forcing().names()) info.forcing_terms.emplace_back(name);
-  info.floedem_version = kFloedemVersion;
+  info.floedem_version = version();
   TowMonitor& tow = stepper.tow();
   ContactLoads loads(scene);
   CollisionTracker collisions(scene, duration_model_of(stepper.engine().info()));

@@ -1,6 +1,6 @@
 #include "run/stepper.hpp"
 
-#include "engine/registry.hpp"
+#include "floedem/engine/registry.hpp"
 
 namespace floedem {
 

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "engine/engine.hpp"
+#include "floedem/engine/engine.hpp"
 #include "engine/step_stages.hpp"
 #include "forcing/force_term.hpp"
-#include "scene/scene.hpp"
+#include "floedem/scene/scene.hpp"
 #include "towing/tow.hpp"
 
 namespace floedem {

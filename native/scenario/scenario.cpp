@@ -1,4 +1,4 @@
-#include "scenario/scenario.hpp"
+#include "floedem/scenario/scenario.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -10,12 +10,12 @@
 
 #include <cmath>
 
-#include "field/field_file.hpp"
-#include "field/field_generator.hpp"
+#include "floedem/field/field_file.hpp"
+#include "floedem/field/field_generator.hpp"
 #include "geometry/polygon.hpp"
-#include "io/body_frame.hpp"
+#include "floedem/io/output.hpp"
 #include "scenario/table_reader.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/scene/input_error.hpp"
 #include "scene/overlap.hpp"
 
 namespace floedem {
@@ -152,24 +152,8 @@ void read_output(TableReader& root, Scene& scene) {
 }
 
 void check_polygon(TableReader& r, BodySpec& b) {
-  if (b.polygon.size() < 3)
-    r.fail("polygon", "has " + std::to_string(b.polygon.size()) + " vertices; allowed at least 3");
-  // Coordinates within 1e7 m (ten thousand kilometres, beyond any ice field): far larger ones
-  // are typing errors, and they break the convex partition's arithmetic (found by fuzzing:
-  // a vertex at 4e75 m crashed CGAL's optimal partition).
-  constexpr double kLargest = 1e7;
-  for (std::size_t k = 0; k < b.polygon.size(); ++k)
-    if (!(std::abs(b.polygon[k].x) <= kLargest && std::abs(b.polygon[k].y) <= kLargest))
-      r.fail("polygon", "vertex " + std::to_string(k) + " lies beyond 1e7 m; allowed |x|, |y| <= 1e7 m");
-  if (const auto hit = find_self_intersection(b.polygon)) {
-    r.fail("polygon", "is self-intersecting (edges " + std::to_string(hit->first) + " and " +
-                          std::to_string(hit->second) + " touch or cross, counting from 0); allowed a simple polygon");
-  }
+  if (const auto problem = polygon_problem(b.polygon)) r.fail("polygon", *problem);
   const double a = signed_area(b.polygon);
-  const Aabb box = bounds_of(b.polygon);
-  const double box_area = (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y);
-  if (!(std::abs(a) > 1e-12 * box_area) || box_area == 0.0)
-    r.fail("polygon", "has zero area; allowed a simple polygon of positive area");
   if (a < 0.0) {
     std::reverse(b.polygon.begin(), b.polygon.end());
     b.reversed_input = true;

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "scene/input_error.hpp"
+#include "floedem/scene/input_error.hpp"
 
 namespace floedem {
 

@@ -2,7 +2,7 @@
 #include <cstddef>
 #include <optional>
 
-#include "scene/scene.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

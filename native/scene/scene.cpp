@@ -1,11 +1,11 @@
-#include "scene/scene.hpp"
+#include "floedem/scene/scene.hpp"
 
 #include <cmath>
 #include <limits>
 
 #include "geometry/convex_partition.hpp"
 #include "geometry/polygon.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/scene/input_error.hpp"
 
 namespace floedem {
 

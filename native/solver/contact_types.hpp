@@ -6,8 +6,8 @@
 #include <cstring>
 #include <type_traits>
 
-#include "engine/engine.hpp"
-#include "geometry/vec2.hpp"
+#include "floedem/engine/engine.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
 

@@ -1,7 +1,7 @@
 #pragma once
 #include <memory>
 
-#include "engine/engine.hpp"
+#include "floedem/engine/engine.hpp"
 
 namespace floedem {
 

@@ -1,5 +1,5 @@
 #pragma once
-#include "scene/scene.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-#include "engine/state_io.hpp"
+#include "floedem/engine/state_io.hpp"
 #include "solver/broad_phase.hpp"
 
 namespace floedem {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "engine/line_vector.hpp"
-#include "scene/scene.hpp"
+#include "floedem/scene/scene.hpp"
 #include "solver/narrow_phase.hpp"
 
 namespace floedem {

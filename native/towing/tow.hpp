@@ -3,8 +3,8 @@
 #include <array>
 #include <span>
 
-#include "engine/engine.hpp"
-#include "scene/scene.hpp"
+#include "floedem/engine/engine.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

@@ -15,7 +15,7 @@
 #include <unordered_map>
 
 #include "geometry/polygon.hpp"
-#include "run/simulation.hpp"
+#include "floedem/run/simulation.hpp"
 #include "scenario/table_reader.hpp"
 
 namespace floedem {

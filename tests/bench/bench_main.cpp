@@ -9,14 +9,14 @@
 #include <random>
 #include <string>
 
-#include "engine/registry.hpp"
+#include "floedem/engine/registry.hpp"
 #include "floe_polygon.hpp"
-#include "field/field_generator.hpp"
+#include "floedem/field/field_generator.hpp"
 #include "forcing/drag.hpp"
 #include "forcing/drag_pass.hpp"
 #include "forcing/force_term.hpp"
 #include "run/stepper.hpp"
-#include "scenario/scenario.hpp"
+#include "floedem/scenario/scenario.hpp"
 #include "solver/broad_phase.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/narrow_phase.hpp"

@@ -12,7 +12,7 @@
 
 #include "contacts/collision_forces.hpp"
 #include "run/stepper.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/scene/input_error.hpp"
 #include "support.hpp"
 
 using namespace floedem;

@@ -14,8 +14,8 @@
 #include <random>
 
 #include "field/exact_geometry.hpp"
-#include "field/field_generator.hpp"
-#include "field/size_distribution.hpp"
+#include "floedem/field/field_generator.hpp"
+#include "floedem/field/size_distribution.hpp"
 #include "geometry/polygon.hpp"
 
 using namespace floedem;

@@ -8,10 +8,10 @@
 #include <fstream>
 
 #include "field/exact_geometry.hpp"
-#include "field/field_file.hpp"
+#include "floedem/field/field_file.hpp"
 #include "geometry/polygon.hpp"
-#include "io/body_frame.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/io/output.hpp"
+#include "floedem/scene/input_error.hpp"
 #include "scene/overlap.hpp"
 #include "support.hpp"
 

@@ -9,7 +9,7 @@
 
 #include "forcing/drag_pass.hpp"
 #include "geometry/lane_isa.hpp"
-#include "scenario/scenario.hpp"
+#include "floedem/scenario/scenario.hpp"
 #include "support.hpp"
 
 using namespace floedem;

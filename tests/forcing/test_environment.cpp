@@ -4,7 +4,7 @@
 #include <complex>
 
 #include "run/stepper.hpp"
-#include "scenario/scenario.hpp"
+#include "floedem/scenario/scenario.hpp"
 #include "support.hpp"
 
 using namespace floedem;

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "geometry/polygon.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/scene/input_error.hpp"
 #include "scene/overlap.hpp"
 #include "solver/part_set.hpp"
 

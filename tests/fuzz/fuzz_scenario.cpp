@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "scenario/scenario.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/scenario/scenario.hpp"
+#include "floedem/scene/input_error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size > 1 << 16) return 0;  // scenario files are small; longer inputs only slow the search

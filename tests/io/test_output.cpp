@@ -9,9 +9,10 @@
 #include <fstream>
 #include <thread>
 
+#include "floedem/version.hpp"
 #include "io/recorder.hpp"
-#include "run/simulation.hpp"
-#include "scene/input_error.hpp"
+#include "floedem/run/simulation.hpp"
+#include "floedem/scene/input_error.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -247,13 +248,20 @@ TEST_CASE("a run's output of another format_version is refused, naming the file 
     const std::int64_t newer = kOutputFormatVersion + 1;
     f.openAttribute("format_version").write(H5::PredType::NATIVE_INT64, &newer);
   }
-  try {
-    read_stored_run(out);
-    FAIL("a newer format was read");
-  } catch (const InputError& e) {
-    const std::string m = e.what();
-    CHECK(m.find(out) == 0);
-    CHECK(m.find("format_version " + std::to_string(kOutputFormatVersion + 1)) != std::string::npos);
-    CHECK(m.find("a newer floedem wrote it") != std::string::npos);
+  for (const bool as_field : {false, true}) {
+    INFO((as_field ? "read_body_frame" : "read_stored_run"));
+    try {
+      if (as_field)
+        read_body_frame(out);
+      else
+        read_stored_run(out);
+      FAIL("a newer format was read");
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      CHECK(m.find(out) == 0);
+      CHECK(m.find("/@format_version: is " + std::to_string(kOutputFormatVersion + 1) + ", this floedem (" + version() +
+                   ") reads " + std::to_string(kOutputFormatVersion)) != std::string::npos);
+      CHECK(m.find("a newer floedem wrote it") != std::string::npos);
+    }
   }
 }

@@ -3,7 +3,7 @@
 // it; each such gap is stated below with its measured size and cause.
 #include <catch2/catch.hpp>
 
-#include "run/simulation.hpp"
+#include "floedem/run/simulation.hpp"
 #include "run/stepper.hpp"
 #include "support.hpp"
 
@@ -54,6 +54,7 @@ std::string impact(double mu, const BodyText& a, const BodyText& b) {
 TEST_CASE("cross-engine: head-on impact of equal squares", "[cross]") {
   const std::string text = impact(0.0, {"a", test::box({5, 5}, 10, 10), {1.0, 0.0}}, {"b", test::box({15, 5}, 10, 10)});
   for (const char* engine : kEngines) {
+    if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Outcome o = run(engine, text, kImpactSteps);
     // Closed form: v_a = (1 - e) / 2, v_b = (1 + e) / 2, J = (1 + e) m / 2.
@@ -67,6 +68,7 @@ TEST_CASE("cross-engine: half-overlapping faces", "[cross]") {
   const std::string text = impact(0.0, {"a", test::box({5, 5}, 10, 10), {1.0, 0.0}}, {"b", test::box({15, 10}, 10, 10)});
   const Outcome ref = run("native", text, kImpactSteps);
   for (const char* engine : kEngines) {
+    if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Outcome o = run(engine, text, kImpactSteps);
     CHECK(o.impulse_on_b == Approx(42545.5).epsilon(1e-3));  // exact 2-D answer (docs/engines.md)
@@ -84,6 +86,7 @@ TEST_CASE("cross-engine: face on corner, frictionless and sticking", "[cross]") 
     const std::string text =
         impact(mu, {"a", test::box({0, 0}, 10, 10), {1.0, 0.0}}, {"b", test::box({5.0 + d, 2.0}, 10, 10, M_PI / 4)});
     for (const char* engine : kEngines) {
+      if (!test::have_engine(engine)) continue;
       INFO(engine << ", mu = " << mu);
       const Outcome o = run(engine, text, kImpactSteps);
       if (mu == 0.0) {
@@ -107,6 +110,7 @@ TEST_CASE("cross-engine: a 3-floe chain", "[cross]") {
   // Momentum is conserved, and Newton's law holds at both contacts in the native answer.
   CHECK(ref.state.velocity[0].x + ref.state.velocity[1].x + ref.state.velocity[2].x == Approx(1.0).epsilon(1e-12));
   for (const char* engine : kEngines) {
+    if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Outcome o = run(engine, text, kImpactSteps);
     for (int i = 0; i < 3; ++i) CHECK(o.state.velocity[i].x == Approx(ref.state.velocity[i].x).margin(1e-3));
@@ -119,6 +123,7 @@ TEST_CASE("cross-engine: a floe pushed against a wall carries the push", "[cross
                            test::body_toml({"floe", test::box({5, 5}, 10, 10), {}, 0.0, false, {push, 0.0}}) +
                            test::body_toml({"wall", test::box({11, 5}, 2, 40), {}, 0.0, true});
   for (const char* engine : kEngines) {
+    if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Outcome o = run(engine, text, 1000);
     // Mean contact force over 10 s = push. Box2D and Bullet hold the floe against the wall
@@ -143,6 +148,7 @@ TEST_CASE("cross-engine: a floe in a steady current against a fixed iceberg", "[
   const double draft = 900.0 / 1025.0;
   const double drag = 0.5 * 1025.0 * 0.9 * 10.0 * draft * 0.25 + 1025.0 * 5e-4 * 100.0 * 0.25;
   for (const char* engine : kEngines) {
+    if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Scene s = test::scene_from(text);
     Stepper stepper(s, engine);
@@ -169,6 +175,7 @@ TEST_CASE("cross-engine: Coriolis alone, the inertial circle on every engine", "
       test::body_toml({"floe", test::box({0, 0}, 10, 10), {0.1, 0.0}});
   const double f = 2.0 * 7.2921e-5 * std::sin(75.0 * M_PI / 180.0), radius = 0.1 / f;
   for (const char* engine : kEngines) {
+    if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Scene s = test::scene_from(text);
     Stepper stepper(s, engine);
@@ -188,6 +195,7 @@ TEST_CASE("cross-engine: ODE and Bullet stay in the plane over 1e4 steps", "[cro
                            test::body_toml({"floe", test::box({5, 5}, 10, 10, 0.2), {0.3, 0.1}, 0.05, false, {2e4, 3e3}}) +
                            test::body_toml({"wall", test::box({16, 5}, 2, 40), {}, 0.0, true});
   for (const char* engine : {"bullet", "ode"}) {
+    if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Outcome o = run(engine, text, 10000);
     CHECK(o.max_out_of_plane < 1e-6);  // m and rad: the required bound
@@ -197,6 +205,7 @@ TEST_CASE("cross-engine: ODE and Bullet stay in the plane over 1e4 steps", "[cro
 TEST_CASE("cross-engine: Box2D refuses steps it would silently shorten", "[cross]") {
   // Box2D caps a body's motion at 2 m per step: a 1 m/s floe at dt = 5 s would be slowed.
   const std::string text = test::header_toml(50.0, 5.0, 0.3, 0.3) + test::body_toml({"a", test::box({0, 0}, 10, 10), {1.0, 0.0}});
+  if (!test::have_engine("box2d")) return;
   const Scene s = test::scene_from(text);
   auto e = make_engine("box2d", s);
   CHECK_THROWS_WITH(e->step(nullptr), Catch::Contains("box2d") && Catch::Contains("shorter dt"));

@@ -2,7 +2,7 @@
 // and the allowed range.
 #include <catch2/catch.hpp>
 
-#include "scene/input_error.hpp"
+#include "floedem/scene/input_error.hpp"
 #include "support.hpp"
 
 using namespace floedem;

@@ -1,6 +1,6 @@
 #include <catch2/catch.hpp>
 
-#include "scene/input_error.hpp"
+#include "floedem/scene/input_error.hpp"
 #include "support.hpp"
 
 using namespace floedem;

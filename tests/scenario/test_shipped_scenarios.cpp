@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "scenario/scenario.hpp"
+#include "floedem/scenario/scenario.hpp"
 
 TEST_CASE("every shipped scenario loads", "[input]") {
   std::size_t count = 0;

@@ -13,7 +13,7 @@
 #include "parallel/thread_pool.hpp"
 #include "parallel/threads.hpp"
 #include "run/stepper.hpp"
-#include "scenario/scenario.hpp"
+#include "floedem/scenario/scenario.hpp"
 #include "geometry/lane_isa.hpp"
 #include "solver/coloured_sweeps.hpp"
 #include "solver/contact_solver.hpp"

@@ -2,7 +2,7 @@
 // pressing light floes against a wall, where Gauss-Seidel alone cannot hold.
 #include <catch2/catch.hpp>
 
-#include "run/simulation.hpp"
+#include "floedem/run/simulation.hpp"
 #include "support.hpp"
 
 using namespace floedem;

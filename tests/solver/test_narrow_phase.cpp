@@ -4,7 +4,7 @@
 #include <limits>
 #include <random>
 
-#include "engine/state_io.hpp"
+#include "floedem/engine/state_io.hpp"
 #include "geometry/lane_isa.hpp"
 #include "run/stepper.hpp"
 #include "solver/narrow_phase.hpp"

@@ -3,7 +3,7 @@
 
 #include <random>
 
-#include "run/simulation.hpp"
+#include "floedem/run/simulation.hpp"
 #include "support.hpp"
 
 using namespace floedem;

@@ -13,7 +13,7 @@
 #include "parallel/thread_pool.hpp"
 #include "parallel/threads.hpp"
 #include "run/stepper.hpp"
-#include "scenario/scenario.hpp"
+#include "floedem/scenario/scenario.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/sweep_pipeline.hpp"
 #include "solver/pressed_pack.hpp"

@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "run/simulation.hpp"
+#include "floedem/run/simulation.hpp"
 #include "run/stepper.hpp"
 #include "support.hpp"
 #include "towing/tow.hpp"

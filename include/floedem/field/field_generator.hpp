@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "field/size_distribution.hpp"
-#include "geometry/vec2.hpp"
+#include "floedem/field/size_distribution.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "io/run_headline.hpp"
-#include "scene/scene.hpp"
+#include "floedem/io/run_headline.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

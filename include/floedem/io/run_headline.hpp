@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/vec2.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "run/simulation.hpp"
+#include "floedem/run/simulation.hpp"
 
 namespace floedem {
 

@@ -9,7 +9,7 @@
 
 #include <toml++/toml.h>
 
-#include "geometry/vec2.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
 

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "engine/stage_clock.hpp"
-#include "engine/state_io.hpp"
-#include "geometry/vec2.hpp"
-#include "scene/scene.hpp"
+#include "floedem/engine/stage_clock.hpp"
+#include "floedem/engine/state_io.hpp"
+#include "floedem/geometry/vec2.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "scene/scene.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

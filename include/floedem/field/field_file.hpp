@@ -1,12 +1,12 @@
 #pragma once
 // A generated field as scene bodies, and as a field file: the /bodies layout of a run's
 // output with one frame at t = 0 (written by the same Recorder), plus /field with the
-// generator's parameters and what it achieved. io/body_frame.hpp reads both.
+// generator's parameters and what it achieved. io/output.hpp reads both.
 #include <string>
 #include <vector>
 
-#include "field/field_generator.hpp"
-#include "scene/scene.hpp"
+#include "floedem/field/field_generator.hpp"
+#include "floedem/scene/scene.hpp"
 
 namespace floedem {
 

@@ -1,0 +1,41 @@
+# `cmake --install`: the command, libfloedem as the CMake package floedem (target
+# floedem::floedem, with a version file), its public headers, and what the command reads at
+# run time (the report's scripts and the scenarios) under share/floedem. The command finds
+# those relative to itself (app/python_script.cpp): bin/../share/floedem when installed, and
+# in the build tree the same layout made of links to the sources (below).
+include(CMakePackageConfigHelpers)
+set(FLOEDEM_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/floedem)
+
+install(TARGETS floedem_lib EXPORT floedemTargets
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(TARGETS floedem RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/floedem DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+  FILES_MATCHING PATTERN "*.hpp")
+install(EXPORT floedemTargets NAMESPACE floedem:: DESTINATION ${FLOEDEM_CMAKE_DIR})
+set(FLOEDEM_ENGINE_NAMES native)
+foreach(_engine IN ITEMS BOX2D BULLET ODE)
+  if(FLOEDEM_WITH_${_engine})
+    string(TOLOWER ${_engine} _lower)
+    list(APPEND FLOEDEM_ENGINE_NAMES ${_lower})
+  endif()
+endforeach()
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/floedemConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/floedemConfig.cmake INSTALL_DESTINATION ${FLOEDEM_CMAKE_DIR})
+# Releases before 1.0 break their interface at every minor version (SameMinorVersion).
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/floedemConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/floedemConfig.cmake ${PROJECT_BINARY_DIR}/floedemConfigVersion.cmake
+  DESTINATION ${FLOEDEM_CMAKE_DIR})
+
+set(FLOEDEM_DATA_DIR ${CMAKE_INSTALL_DATADIR}/floedem)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/reports/ DESTINATION ${FLOEDEM_DATA_DIR}/reports
+  FILES_MATCHING PATTERN "*.py" PATTERN "latest" EXCLUDE PATTERN "bench" EXCLUDE PATTERN "threads-*" EXCLUDE
+  PATTERN "__pycache__" EXCLUDE)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenarios/ DESTINATION ${FLOEDEM_DATA_DIR}/scenarios)
+
+# The build tree's share/floedem: links to the sources, so that an edited script is the one run.
+file(MAKE_DIRECTORY ${PROJECT_BINARY_DIR}/share/floedem)
+foreach(_dir IN ITEMS reports scenarios)
+  file(CREATE_LINK ${PROJECT_SOURCE_DIR}/${_dir} ${PROJECT_BINARY_DIR}/share/floedem/${_dir} SYMBOLIC)
+endforeach()
