@@ -20,15 +20,15 @@ foreach(_engine IN ITEMS BOX2D BULLET ODE)
     list(APPEND FLOEDEM_ENGINE_NAMES ${_lower})
   endif()
 endforeach()
+set(FLOEDEM_DATA_DIR ${CMAKE_INSTALL_DATADIR}/floedem)
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/floedemConfig.cmake.in
-  ${PROJECT_BINARY_DIR}/floedemConfig.cmake INSTALL_DESTINATION ${FLOEDEM_CMAKE_DIR})
+  ${PROJECT_BINARY_DIR}/floedemConfig.cmake INSTALL_DESTINATION ${FLOEDEM_CMAKE_DIR} PATH_VARS FLOEDEM_DATA_DIR)
 # Releases before 1.0 break their interface at every minor version (SameMinorVersion).
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/floedemConfigVersion.cmake
   COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/floedemConfig.cmake ${PROJECT_BINARY_DIR}/floedemConfigVersion.cmake
   DESTINATION ${FLOEDEM_CMAKE_DIR})
 
-set(FLOEDEM_DATA_DIR ${CMAKE_INSTALL_DATADIR}/floedem)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/reports/ DESTINATION ${FLOEDEM_DATA_DIR}/reports
   FILES_MATCHING PATTERN "*.py" PATTERN "latest" EXCLUDE PATTERN "bench" EXCLUDE PATTERN "threads-*" EXCLUDE
   PATTERN "__pycache__" EXCLUDE)

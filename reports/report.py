@@ -26,6 +26,9 @@ from sections import SECTIONS  # noqa: E402
 from sections.speed import load_stage_labels  # noqa: E402
 
 
+REFERENCE_ENGINES = ["box2d", "bullet", "ode"]   # floedem's own references (docs/engines.md)
+
+
 class Context:
     """What every section sees: the options, where things go, and the runs by tag."""
 
@@ -87,6 +90,11 @@ def main():
     version = floedem_text(a.floedem, "--version").strip()
     listed = [line.split("\t")[0] for line in floedem_text(a.floedem, "engines").splitlines() if line.strip()]
     engines = ["native"] + [e for e in listed if e != "native"]
+    # A build configured without a reference engine (FLOEDEM_WITH_ODE=OFF, ...) reports on the
+    # engines it has; what it skips is said here and at the head of the report.
+    missing = [e for e in REFERENCE_ENGINES if e not in engines]
+    if missing:
+        print(f"report: this build has no {', '.join(missing)} engine: their runs and checks are skipped", flush=True)
     ctx = Context(a, engines)
     load_stage_labels(a.floedem)
     for d in (ctx.fig, ctx.runs_dir):
@@ -130,8 +138,11 @@ def main():
             f"{flags}` ({version}, source commit {commit}) on {platform.node()} "
             f"({os.cpu_count()} cores, {a.jobs} runs at a time): {len(ctx.all_runs)} runs in {run_seconds:.0f} s, "
             f"{total:.0f} s in all. Every table and figure below comes from the HDF5 files of those runs, in "
-            "`runs/` (each table names its files); none is typed or kept from an earlier report.", "",
-            "## Cross-check", ""]
+            "`runs/` (each table names its files); none is typed or kept from an earlier report.", ""]
+    if missing:
+        head += [f"This build has no {', '.join(missing)} engine (configured off, or its library not found): the "
+                 "runs and checks on it are skipped, and the report compares the engines it has.", ""]
+    head += ["## Cross-check", ""]
     if fails:
         head += [f"**{len(fails)} disagreement{'s' if len(fails) > 1 else ''} beyond the documented tolerances:**", ""] + [f"- {x}" for x in fails]
     else:

@@ -1,27 +1,53 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing, builds, and runs every test with ctest.
-#   scripts/test.sh              Release build in ./build, then the cross-engine check
-#                                (`floedem report --quick`, 3 to 4 minutes on 2 cores)
-#   scripts/test.sh --sanitize   the same suite built with AddressSanitizer and
-#                                UndefinedBehaviorSanitizer in ./build-sanitize; any report fails
+#   scripts/test.sh                 Release build in ./build, its ctest, then the cross-engine check
+#                                   (`floedem report --quick`, 3 to 4 minutes on 2 cores) by the
+#                                   command installed into build/install, run from another directory
+#   scripts/test.sh --sanitize      the same suite built with AddressSanitizer and
+#                                   UndefinedBehaviorSanitizer in ./build-sanitize; any report fails
+#   scripts/test.sh --no-reference  the build without the reference engines (FLOEDEM_WITH_ODE,
+#                                   _BULLET, _BOX2D off) in ./build-native: its ctest and quick report
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$root/scripts/setup.sh"
 jobs="$(nproc 2>/dev/null || echo 2)"
-if [[ "${1:-}" == "--sanitize" ]]; then
-  build="${FLOEDEM_BUILD_DIR:-$root/build-sanitize}"
-  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLOEDEM_SANITIZE=ON >/dev/null
-  cmake --build "$build" -j "$jobs"
-  export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:${ASAN_OPTIONS:-}"
-  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
-else
-  bash "$root/scripts/build.sh"
-  build="${FLOEDEM_BUILD_DIR:-$root/build}"
-fi
+mode="${1:-}"
+case "$mode" in
+  --sanitize)
+    build="${FLOEDEM_BUILD_DIR:-$root/build-sanitize}"
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLOEDEM_SANITIZE=ON >/dev/null
+    cmake --build "$build" -j "$jobs"
+    export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:${ASAN_OPTIONS:-}"
+    export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
+    ;;
+  --no-reference)
+    build="${FLOEDEM_BUILD_DIR:-$root/build-native}"
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DFLOEDEM_WITH_ODE=OFF -DFLOEDEM_WITH_BULLET=OFF \
+      -DFLOEDEM_WITH_BOX2D=OFF >/dev/null
+    cmake --build "$build" -j "$jobs"
+    ;;
+  "")
+    bash "$root/scripts/build.sh"
+    build="${FLOEDEM_BUILD_DIR:-$root/build}"
+    ;;
+  *)
+    echo "usage: scripts/test.sh [--sanitize | --no-reference]" >&2
+    exit 2
+    ;;
+esac
 cd "$build"
 ctest --output-on-failure -j "$jobs"
-if [[ "${1:-}" != "--sanitize" ]]; then
-  # The engines against each other and native against the closed forms, on small cases:
-  # fails (exit 5, each disagreement printed) beyond the tolerances the report states.
-  "$build/floedem" report --quick --out "$build/report-quick"
-fi
+case "$mode" in
+  "")
+    # The engines against each other and native against the closed forms, on small cases:
+    # fails (exit 5, each disagreement printed) beyond the tolerances the report states. Run by
+    # the installed command, from a directory of its own: it finds its scripts beside itself.
+    rm -rf "$build/install" "$build/report-quick"
+    cmake --install "$build" --prefix "$build/install" >/dev/null
+    mkdir -p "$build/report-quick"
+    (cd "$build/report-quick" && "$build/install/bin/floedem" report --quick --out .)
+    ;;
+  --no-reference)
+    "$build/floedem" report --quick --out "$build/report-quick"
+    ;;
+esac

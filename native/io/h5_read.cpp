@@ -39,6 +39,7 @@ const char* class_text(H5T_class_t c) {
     case H5T_INTEGER: return "integers";
     case H5T_FLOAT: return "floating-point numbers";
     case H5T_STRING: return "strings";
+    case H5T_ENUM: return "enumerated values";
     default: return "other values";
   }
 }
@@ -120,7 +121,7 @@ std::uint64_t CheckedFile::unsigned_attribute(const std::string& object, const s
   return v;
 }
 
-H5::DataSet CheckedFile::open(const std::string& name, H5T_class_t type_class, const std::vector<std::int64_t>& shape,
+H5::DataSet CheckedFile::dataset(const std::string& name, H5T_class_t type_class, const std::vector<std::int64_t>& shape,
                               std::vector<hsize_t>& dims) const {
   if (!exists(name)) fail(name, "missing; expected in every floedem file of this kind (docs/output.md)");
   if (file_.childObjType(name) != H5O_TYPE_DATASET) fail(name, "is not a dataset");
@@ -147,7 +148,7 @@ H5::DataSet CheckedFile::open(const std::string& name, H5T_class_t type_class, c
 
 std::vector<double> CheckedFile::reals(const std::string& name, const std::vector<std::int64_t>& shape,
                                        std::vector<hsize_t>& dims) const {
-  H5::DataSet ds = open(name, H5T_FLOAT, shape, dims);
+  H5::DataSet ds = dataset(name, H5T_FLOAT, shape, dims);
   hsize_t count = 1;
   for (const hsize_t d : dims) count *= d;
   std::vector<double> out(count);
@@ -159,7 +160,7 @@ std::vector<double> CheckedFile::reals(const std::string& name, const std::vecto
 
 std::vector<double> CheckedFile::real_row(const std::string& name, const std::vector<std::int64_t>& shape, hsize_t row) const {
   std::vector<hsize_t> dims;
-  H5::DataSet ds = open(name, H5T_FLOAT, shape, dims);
+  H5::DataSet ds = dataset(name, H5T_FLOAT, shape, dims);
   if (dims.empty() || row >= dims[0]) fail(name, "has no row " + std::to_string(row));
   H5::DataSpace space = ds.getSpace();
   std::vector<hsize_t> start(dims.size(), 0), count = dims;
@@ -179,7 +180,7 @@ std::vector<double> CheckedFile::real_row(const std::string& name, const std::ve
 
 std::vector<std::int64_t> CheckedFile::integers(const std::string& name, const std::vector<std::int64_t>& shape,
                                                 std::vector<hsize_t>& dims) const {
-  H5::DataSet ds = open(name, H5T_INTEGER, shape, dims);
+  H5::DataSet ds = dataset(name, H5T_INTEGER, shape, dims);
   hsize_t count = 1;
   for (const hsize_t d : dims) count *= d;
   std::vector<std::int64_t> out(count);
@@ -189,7 +190,7 @@ std::vector<std::int64_t> CheckedFile::integers(const std::string& name, const s
 
 std::vector<std::uint8_t> CheckedFile::bytes(const std::string& name, const std::vector<std::int64_t>& shape) const {
   std::vector<hsize_t> dims;
-  H5::DataSet ds = open(name, H5T_INTEGER, shape, dims);
+  H5::DataSet ds = dataset(name, H5T_INTEGER, shape, dims);
   if (ds.getDataType().getSize() != 1) fail(name, "expected bytes (8-bit integers)");
   hsize_t count = 1;
   for (const hsize_t d : dims) count *= d;
@@ -200,7 +201,7 @@ std::vector<std::uint8_t> CheckedFile::bytes(const std::string& name, const std:
 
 std::vector<std::string> CheckedFile::strings(const std::string& name, std::int64_t n) const {
   std::vector<hsize_t> dims;
-  H5::DataSet ds = open(name, H5T_STRING, {n}, dims);
+  H5::DataSet ds = dataset(name, H5T_STRING, {n}, dims);
   if (!ds.getStrType().isVariableStr()) fail(name, "expected variable-length strings");
   return read_strings(file_, name);
 }

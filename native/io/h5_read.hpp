@@ -58,11 +58,14 @@ class CheckedFile {
   /// A 1-D dataset of n strings.
   std::vector<std::string> strings(const std::string& name, std::int64_t n) const;
 
+  /// The dataset, checked for its type class and shape (and that it stores what it claims),
+  /// unread; its shape in `dims`.
+  H5::DataSet dataset(const std::string& name, H5T_class_t type_class, const std::vector<std::int64_t>& shape,
+                      std::vector<hsize_t>& dims) const;
+
   const std::string& label() const { return label_; }
 
  private:
-  H5::DataSet open(const std::string& name, H5T_class_t type_class, const std::vector<std::int64_t>& shape,
-                   std::vector<hsize_t>& dims) const;
   H5::Attribute scalar_attribute(const std::string& object, const std::string& name, H5T_class_t type_class) const;
   H5::H5File& file_;
   std::string label_;

@@ -12,6 +12,7 @@
 #include "floedem/engine/state_io.hpp"
 #include "floedem/scene/input_error.hpp"
 #include "floedem/version.hpp"
+#include "io/h5_read.hpp"
 
 namespace floedem {
 
@@ -410,6 +411,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& r
     : impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
   namespace fs = std::filesystem;
   H5::Exception::dontPrint();
+  check_tables(fs::exists(partial_path_) ? partial_path_ : path_, scene, rows);
   // A finished run being continued is no longer complete: it goes back under .partial first.
   if (!fs::exists(partial_path_)) {
     std::error_code ec;
@@ -477,6 +479,30 @@ RecordedRows Recorder::rows() const {
 }
 
 std::int64_t Recorder::frame_chunk() const { return static_cast<std::int64_t>(impl_->frame_chunk); }
+
+void Recorder::check_tables(const std::string& file, const Scene& scene, const RecordedRows& rows) const {
+  H5::Exception::dontPrint();
+  try {
+    H5::H5File f(file, H5F_ACC_RDONLY);
+    const CheckedFile checked(f, file);
+    Impl layout;
+    layout.bodies = scene.bodies.size();
+    layout.frame_chunk = frame_chunk_of(layout.bodies);
+    layout.contact_output = scene.output.contacts;
+    layout.tow = scene.tow.mode != TowSpec::Mode::none;
+    for (const Impl::Table& t : layout.tables(scene)) {
+      std::vector<std::int64_t> shape{-1};
+      for (const hsize_t d : t.row_shape) shape.push_back(static_cast<std::int64_t>(d));
+      std::vector<hsize_t> dims;
+      checked.dataset(t.path, t.type.getClass(), shape, dims);
+      if (static_cast<std::int64_t>(dims[0]) < rows.*t.rows)
+        checked.fail(t.path, "has " + std::to_string(dims[0]) + " rows; its checkpoint counts " +
+                                 std::to_string(rows.*t.rows) + ": damaged");
+    }
+  } catch (const H5::Exception& e) {
+    throw InputError(file + ": cannot read it (" + e.getDetailMsg() + "); damaged, or not a floedem file?");
+  }
+}
 
 void Recorder::check_space(const Scene& scene) const {
   // The frames' size is known before the run: 6 doubles per body and frame (position, angle,
