@@ -16,7 +16,7 @@
 #include "io/recorder.hpp"
 #include "parallel/threads.hpp"
 #include "floedem/run/simulation.hpp"
-#include "run/stepper.hpp"
+#include "floedem/run/bench.hpp"
 #include "floedem/scenario/scenario.hpp"
 #include "floedem/scene/input_error.hpp"
 #include "floedem/version.hpp"
@@ -84,13 +84,6 @@ double peak_resident_mb() {
   return std::nan("");
 }
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return std::nan("");
-  const auto k = static_cast<std::size_t>(std::clamp(p, 0.0, 1.0) * static_cast<double>(v.size() - 1) + 0.5);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
 }  // namespace
 
 CLI::App* add_bench_command(CLI::App& app, BenchCommand& c) {
@@ -113,68 +106,26 @@ CLI::App* add_bench_command(CLI::App& app, BenchCommand& c) {
 }
 
 int run_bench_command(const BenchCommand& c) {
-  using clock = std::chrono::steady_clock;
-  const auto start = clock::now();
+  // setup_s and total_s count the scenario's loading too (a generated field's making).
+  const auto start = std::chrono::steady_clock::now();
   const Scene scene = load_scenario(c.scenario, c.overrides);
-  Stepper stepper(scene, c.engine);
-  const double setup = std::chrono::duration<double>(clock::now() - start).count();
-
-  const std::int64_t steps = scene.run.steps();
-  if (steps < 1) throw InputError(c.scenario + ": run.duration is shorter than one step of run.dt: nothing to time");
-  const std::int64_t timed = c.window > 0.0 ? std::clamp<std::int64_t>(std::llround(c.window / scene.run.dt), 1, steps) : steps;
-  const std::int64_t first_timed = steps - timed + 1;
-  std::vector<double> ms;
-  ms.reserve(static_cast<std::size_t>(timed));
-  std::size_t moving = 0;
-  for (const BodySpec& b : scene.bodies) moving += b.fixed ? 0 : 1;
-  std::vector<std::uint8_t> touched(scene.bodies.size());
-  double contact_fraction_sum = 0.0, max_penetration = 0.0, penetration_sum = 0.0;
-  std::int64_t overlaps = 0;
-  std::uint64_t allocations_at_window = 0;
-  auto last_progress = clock::now();
-  for (std::int64_t k = 1; k <= steps; ++k) {
-    if (k == first_timed) {
-      allocations_at_window = allocations_so_far();
-      stepper.time_stages(c.stages);  // the stages' sums cover the timed steps alone
-    }
-    const auto t0 = clock::now();
-    stepper.step();
-    const auto t1 = clock::now();
-    if (k < first_timed) continue;
-    ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-    // What the timed steps achieved (outside the timing; no allocation: `touched` is reused).
-    std::fill(touched.begin(), touched.end(), 0);
-    for (const ContactRecord& r : stepper.contacts()) {
-      touched[static_cast<std::size_t>(r.body_a)] = touched[static_cast<std::size_t>(r.body_b)] = 1;
-      if (r.separation < 0.0) {
-        max_penetration = std::max(max_penetration, -r.separation);
-        penetration_sum -= r.separation;
-        ++overlaps;
-      }
-    }
-    std::size_t in_contact = 0;
-    for (std::size_t i = 0; i < touched.size(); ++i) in_contact += touched[i] && !scene.bodies[i].fixed;
-    contact_fraction_sum += moving > 0 ? static_cast<double>(in_contact) / static_cast<double>(moving) : 0.0;
-    if (!c.quiet && std::chrono::duration<double>(t1 - last_progress).count() > 10.0) {
-      last_progress = t1;
+  const double loading = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  BenchOptions options;
+  options.engine = c.engine;
+  options.window = c.window;
+  options.stages = c.stages;
+  options.allocations = allocations_so_far;
+  if (!c.quiet)
+    options.progress = [&](std::int64_t k, std::int64_t steps) {
       std::fprintf(stderr, "bench: %s on %s: step %lld/%lld\n", c.scenario.c_str(), c.engine.c_str(),
                    static_cast<long long>(k), static_cast<long long>(steps));
-    }
-  }
-  const std::uint64_t allocations = allocations_so_far() - allocations_at_window;
+    };
+  const BenchResult r = bench_scene(scene, options);
   // With --stages, the mean ms a timed step per stage, "name=ms" separated by spaces (one CSV
   // field); the forcing and towing alone for an engine that does not time its own stages.
   std::ostringstream stages;
   stages.precision(4);
-  if (c.stages)
-    for (const StageTime& t : stepper.stage_times())
-      stages << (stages.tellp() > 0 ? " " : "") << t.name << '=' << 1e3 * t.seconds / static_cast<double>(timed);
-  for (const Vec2 p : stepper.state().position)
-    if (!std::isfinite(p.x) || !std::isfinite(p.y)) throw SolverFailure("non-finite body state at the end of the run");
-  const double total = std::chrono::duration<double>(clock::now() - start).count();
-  double mean = 0.0;
-  for (const double x : ms) mean += x;
-  mean /= static_cast<double>(std::max<std::size_t>(ms.size(), 1));
+  for (const StageTime& t : r.stages) stages << (stages.tellp() > 0 ? " " : "") << t.name << '=' << 1e3 * t.seconds;
   const double peak_mb = peak_resident_mb();
 
   std::string overrides;
@@ -183,11 +134,10 @@ int run_bench_command(const BenchCommand& c) {
   row.precision(6);
   row << field(host_name()) << ',' << field(cpu_model()) << ',' << worker_threads() << ',' << field(version()) << ','
       << field(std::filesystem::path(c.scenario).filename().string()) << ',' << field(overrides) << ',' << c.engine << ','
-      << field(stepper.engine().info().version) << ',' << scene.bodies.size() << ',' << moving << ',' << scene.run.dt << ','
-      << steps << ',' << timed << ',' << percentile(ms, 0.5) << ',' << mean << ',' << percentile(ms, 0.1) << ','
-      << percentile(ms, 0.9) << ',' << setup << ',' << total << ',' << contact_fraction_sum / static_cast<double>(timed)
-      << ',' << max_penetration << ',' << (overlaps > 0 ? penetration_sum / static_cast<double>(overlaps) : 0.0) << ','
-      << static_cast<double>(allocations) / static_cast<double>(timed) << ',' << peak_mb << ',' << field(stages.str());
+      << field(r.engine_version) << ',' << scene.bodies.size() << ',' << r.moving_bodies << ',' << scene.run.dt << ','
+      << r.steps << ',' << r.timed_steps << ',' << r.median_ms << ',' << r.mean_ms << ',' << r.p10_ms << ',' << r.p90_ms
+      << ',' << loading + r.setup_seconds << ',' << loading + r.total_seconds << ',' << r.contact_fraction << ',' << r.max_penetration << ','
+      << r.mean_penetration << ',' << r.allocations_per_step << ',' << peak_mb << ',' << field(stages.str());
   std::cout << kHeader << '\n' << row.str() << '\n';
   if (!c.csv.empty()) {
     const std::filesystem::path dir = std::filesystem::path(c.csv).parent_path();

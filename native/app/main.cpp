@@ -12,7 +12,7 @@
 #include "app/field_command.hpp"
 #include "app/python_script.hpp"
 #include "floedem/engine/registry.hpp"
-#include "engine/step_stages.hpp"
+#include "floedem/engine/step_stages.hpp"
 #include "io/recorder.hpp"
 #include "floedem/run/resume.hpp"
 #include "floedem/run/simulation.hpp"

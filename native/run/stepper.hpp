@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "floedem/engine/engine.hpp"
-#include "engine/step_stages.hpp"
+#include "floedem/engine/step_stages.hpp"
 #include "forcing/force_term.hpp"
 #include "floedem/scene/scene.hpp"
 #include "towing/tow.hpp"
@@ -55,7 +55,7 @@ class Stepper {
   TowMonitor tow_;
   std::int64_t steps_ = 0;
   const Loads* loads_ = nullptr;
-  // The two stages of engine/step_stages.hpp that the stepper makes around the engine's own.
+  // The two stages of floedem/engine/step_stages.hpp that the stepper makes around the engine's own.
   enum Stage : std::size_t { kForcing, kTowing, kStages };
   StageClock<kStages> stages_{{kStepStages[step_stage("forcing")].name, kStepStages[step_stage("towing")].name}};
 };

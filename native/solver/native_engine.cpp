@@ -1,5 +1,5 @@
 // The native planar non-smooth DEM. One step (NativeEngine::step) makes the stages of
-// engine/step_stages.hpp from broad_phase to record, in that list's order; docs/architecture.md
+// floedem/engine/step_stages.hpp from broad_phase to record, in that list's order; docs/architecture.md
 // describes what each reads and writes.
 #include "solver/native_engine.hpp"
 
@@ -11,7 +11,7 @@
 
 #include "engine/line_vector.hpp"
 #include "engine/prefetch.hpp"
-#include "engine/step_stages.hpp"
+#include "floedem/engine/step_stages.hpp"
 #include "solver/broad_phase.hpp"
 #include "solver/pair_cache.hpp"
 #include "solver/contact_islands.hpp"
@@ -100,7 +100,7 @@ class NativeEngine final : public Engine {
   ContactSettings contact_;
   double dt_;
   // Wall time per stage of step(), when asked for (floedem bench): the stages of
-  // engine/step_stages.hpp from broad_phase to record, in step()'s order.
+  // floedem/engine/step_stages.hpp from broad_phase to record, in step()'s order.
   enum Stage : std::size_t {
     kBroad, kNarrow, kContactList, kLoads, kSolve, kRedetect, kIntegrate, kProject, kRecord, kStages
   };

@@ -152,7 +152,7 @@ def stages(row):
 
 
 # The stages of a native step as the report names them, in the order of a step: filled once from
-# `floedem stages` (native/engine/step_stages.hpp, the one list) by load_stage_labels.
+# `floedem stages` (include/floedem/engine/step_stages.hpp, the one list) by load_stage_labels.
 STAGE_LABELS = {}
 
 
