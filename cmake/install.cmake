@@ -33,9 +33,25 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/reports/ DESTINATION ${FLOEDEM_DATA_DIR}
   FILES_MATCHING PATTERN "*.py" PATTERN "latest" EXCLUDE PATTERN "bench" EXCLUDE PATTERN "threads-*" EXCLUDE
   PATTERN "__pycache__" EXCLUDE)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenarios/ DESTINATION ${FLOEDEM_DATA_DIR}/scenarios)
+# The Python package: beside the command (which runs `python3 -m floedem` from there), with its
+# pyproject.toml (pip install PREFIX/share/floedem/python), and where the Python that found
+# numpy and h5py looks for packages of this prefix (cmake/python_site.py), so that
+# `python3 -c "import floedem"` works after the install.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/python/ DESTINATION ${FLOEDEM_DATA_DIR}/python
+  PATTERN "__pycache__" EXCLUDE PATTERN "tests" EXCLUDE PATTERN "*.egg-info" EXCLUDE)
+if(FLOEDEM_PYTHON)
+  install(CODE "
+    execute_process(COMMAND ${FLOEDEM_PYTHON} ${PROJECT_SOURCE_DIR}/cmake/python_site.py \"\${CMAKE_INSTALL_PREFIX}\"
+      OUTPUT_VARIABLE _site OUTPUT_STRIP_TRAILING_WHITESPACE RESULT_VARIABLE _rc)
+    if(NOT _rc EQUAL 0)
+      message(FATAL_ERROR \"floedem: cannot tell where Python looks for packages under \${CMAKE_INSTALL_PREFIX}\")
+    endif()
+    file(INSTALL ${PROJECT_SOURCE_DIR}/python/floedem DESTINATION \"\${_site}\" PATTERN __pycache__ EXCLUDE)
+    message(STATUS \"floedem: Python package in \${_site}\")")
+endif()
 
 # The build tree's share/floedem: links to the sources, so that an edited script is the one run.
 file(MAKE_DIRECTORY ${PROJECT_BINARY_DIR}/share/floedem)
-foreach(_dir IN ITEMS reports scenarios)
+foreach(_dir IN ITEMS reports scenarios python)
   file(CREATE_LINK ${PROJECT_SOURCE_DIR}/${_dir} ${PROJECT_BINARY_DIR}/share/floedem/${_dir} SYMBOLIC)
 endforeach()

@@ -13,12 +13,14 @@ import os
 import subprocess
 import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), "python"))
+import floedem  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = os.path.join(ROOT, "scenarios", "free_drift.toml")
@@ -27,22 +29,22 @@ STEPS = [960.0, 480.0, 240.0, 120.0, 60.0, 30.0, 15.0]
 REFERENCE = 1.875
 
 
-def final_state(floedem, outdir, dt):
+def final_state(command, outdir, dt):
     out = os.path.join(outdir, f"free_drift_dt{dt:g}.h5")
     steps = int(round(DURATION / dt))
-    subprocess.run([floedem, "run", SCENARIO, "--quiet", "--out", out, "--set", f"run.dt={dt!r}",
+    subprocess.run([command, "run", SCENARIO, "--quiet", "--out", out, "--set", f"run.dt={dt!r}",
                     "--set", f"run.output_every={steps}"], check=True)
-    with h5py.File(out, "r") as f:
-        return f["time"][-1], f["bodies/position"][-1, 0], f["bodies/angle"][-1, 0]
+    with floedem.open(out) as f:
+        return f.time[-1], f.position[-1, 0], f.angle[-1, 0]
 
 
 def main():
-    floedem, outdir = sys.argv[1], sys.argv[2]
+    command, outdir = sys.argv[1], sys.argv[2]
     os.makedirs(outdir, exist_ok=True)
-    _, x_ref, a_ref = final_state(floedem, outdir, REFERENCE)
+    _, x_ref, a_ref = final_state(command, outdir, REFERENCE)
     rows = []
     for dt in STEPS:
-        t, x, a = final_state(floedem, outdir, dt)
+        t, x, a = final_state(command, outdir, dt)
         assert abs(t - DURATION) < 1e-6 * DURATION
         rows.append({"dt_s": dt, "position_error_m": float(np.linalg.norm(x - x_ref)),
                      "angle_error_rad": float(abs(a - a_ref))})

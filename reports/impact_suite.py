@@ -18,12 +18,13 @@ import math
 import os
 import sys
 
-import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), "python"))
+import floedem  # noqa: E402
 from report_runner import Run, run_all  # noqa: E402
 
 SCENARIOS = ["floe_structure_headon", "floe_structure_oblique", "floe_floe_headon", "floe_floe_oblique"]
@@ -128,12 +129,12 @@ def plan(quick, engines):
 
 def read(run, rel_to):
     """The run's one collision event, with the run's description."""
-    with h5py.File(run.out, "r") as f:
-        g = f["contacts/collisions"]
-        if len(g["time"]) != 1:
-            raise RuntimeError(f"{run.out}: {len(g['time'])} collision events, expected 1")
-        row = {k: float(g[k][0]) for k in ("normal_impulse", "effective_mass", "approach_speed",
-                                          "restitution_achieved", "duration", "mean_force", "peak_force")}
+    with floedem.open(run.out) as f:
+        g = f.collisions
+        if len(g) != 1:
+            raise RuntimeError(f"{run.out}: {len(g)} collision events, expected 1")
+        row = {k: float(getattr(g, k)[0]) for k in ("normal_impulse", "effective_mass", "approach_speed",
+                                                    "restitution_achieved", "duration", "mean_force", "peak_force")}
     row.update(run.meta)
     row["file"] = os.path.relpath(run.out, rel_to)
     return row

@@ -7,8 +7,8 @@ usage: plot_field.py FIELD.h5 --out OUT.png
 """
 import argparse
 import os
+import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
@@ -17,23 +17,17 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.patches import Polygon, Rectangle  # noqa: E402
 
-from floedem_h5 import (body_polygons, equal_area_diameters, polygons,  # noqa: E402
-                        truncated_power_law_survival)
-
-
-def field_bodies(f):
-    """The range of body indices that are the field's floes (a run's output has the
-    scenario's own bodies first)."""
-    g = f["field"].attrs
-    first = int(g.get("first_floe", 0))
-    return first, first + int(g["floes"])
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), "python"))
+import floedem  # noqa: E402
+from floedem.stats import equal_area_diameters, truncated_power_law_survival  # noqa: E402
 
 
 def draw_field(f, out, title=None):
-    g = f["field"].attrs
+    """f: a floedem.Run with /field (a field file, or a run with a generated field)."""
+    g = f.provenance["field"]
     x0, y0, w, h = g["origin_x"], g["origin_y"], g["width"], g["height"]
-    a, b = field_bodies(f)
-    bodies = body_polygons(f, 0)
+    a, b = f.field_range()
+    bodies = f.polygons(0)
     floes = bodies[a:b]
     size = 9.0
     fig, ax = plt.subplots(figsize=(size, size * h / w + 0.8))
@@ -42,7 +36,7 @@ def draw_field(f, out, title=None):
     others = bodies[:a] + bodies[b:]
     if others:
         ax.add_collection(PolyCollection(others, facecolors="0.35", edgecolors="k", linewidths=0.5))
-    for zone in polygons(f, "field", "keep_out") if "field/keep_out_vertices" in f else []:
+    for zone in f.keep_out():
         ax.add_patch(Polygon(zone, closed=True, fill=False, hatch="//", edgecolor="0.4", linewidth=0.8))
     ax.add_patch(Rectangle((x0, y0), w, h, fill=False, edgecolor="k", linewidth=1.0))
     ax.set_xlim(x0 - 0.02 * w, x0 + 1.02 * w)
@@ -58,9 +52,9 @@ def draw_field(f, out, title=None):
 
 
 def draw_sizes(f, out):
-    g = f["field"].attrs
-    a, b = field_bodies(f)
-    d = np.sort(equal_area_diameters(f)[a:b])
+    g = f.provenance["field"]
+    a, b = f.field_range()
+    d = np.sort(equal_area_diameters(f.bodies.area)[a:b])
     n = len(d)
     survival = 1.0 - (np.arange(n) + 0.5) / n  # fraction larger than d (midpoint plotting positions)
     grid = np.geomspace(g["d_min"], g["d_max"], 200)
@@ -85,8 +79,12 @@ def main():
     ap.add_argument("field")
     ap.add_argument("--out", required=True, help="PNG of the field; the sizes go to OUT-sizes.png")
     a = ap.parse_args()
-    with h5py.File(a.field, "r") as f:
-        if "field" not in f:
+    try:
+        f = floedem.open(a.field)
+    except floedem.FileError as e:
+        raise SystemExit(f"plot_field: {e}")
+    with f:
+        if "field" not in f.provenance:
             raise SystemExit(f"{a.field}: no /field group: not a field file (floedem field writes one)")
         draw_field(f, a.out)
         stem, ext = os.path.splitext(a.out)

@@ -4,8 +4,9 @@
 usage: plot_snapshots.py RESULT.h5 OUT.png [--frames N]
 """
 import argparse
+import os
+import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
@@ -13,7 +14,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 
-from floedem_h5 import body_polygons  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), "python"))
+import floedem  # noqa: E402
 
 
 def main():
@@ -22,15 +24,19 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--frames", type=int, default=4)
     a = ap.parse_args()
-    with h5py.File(a.result, "r") as f:
-        t = f["time"][:]
-        fixed = f["bodies/fixed"][:].astype(bool)
+    try:
+        f = floedem.open(a.result)
+    except floedem.FileError as e:
+        raise SystemExit(f"plot_snapshots: {e}")
+    with f:
+        t = f.time
+        fixed = f.bodies.fixed.astype(bool)
         picks = np.linspace(0, len(t) - 1, a.frames).astype(int)
         fig, axes = plt.subplots(1, len(picks), figsize=(4 * len(picks), 4), squeeze=False)
-        all_pts = np.concatenate([np.concatenate(body_polygons(f, p)) for p in picks])
+        all_pts = np.concatenate([f.world_vertices(p) for p in picks])
         lo, hi = all_pts.min(axis=0), all_pts.max(axis=0)
         for ax, p in zip(axes[0], picks):
-            polys = body_polygons(f, p)
+            polys = f.polygons(p)
             colours = ["0.35" if fx else "#9ecae1" for fx in fixed]
             ax.add_collection(PolyCollection(polys, facecolors=colours, edgecolors="k", linewidths=0.4))
             ax.set_xlim(lo[0], hi[0])
@@ -39,7 +45,7 @@ def main():
             ax.set_title(f"t = {t[p]:.1f} s")
             ax.set_xlabel("x (m)")
         axes[0][0].set_ylabel("y (m)")
-        fig.suptitle(f"{f.attrs['scenario_path']} on {f.attrs['engine']}")
+        fig.suptitle(f"{f.attrs.get('scenario_path', a.result)} on {f.engine}")
         fig.tight_layout()
         fig.savefig(a.out, dpi=110)
 

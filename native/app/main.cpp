@@ -106,6 +106,27 @@ int main(int argc, char** argv) {
   report->add_option("--jobs,-j", report_jobs, "runs at a time (default: the number of cores)")
       ->check(CLI::PositiveNumber);
 
+  // The Python package's commands (python/floedem): the command parses, the package does the work.
+  std::string export_run, export_out;
+  bool export_xdmf = false;
+  CLI::App* export_cmd = app.add_subcommand(
+      "export", "write a run as XDMF for ParaView, beside it: RESULT.xdmf and RESULT.xdmf.h5 (the run's file is only read)");
+  export_cmd->add_option("run", export_run, "a run's output, RESULT.h5")->required();
+  export_cmd->add_flag("--xdmf", export_xdmf, "XDMF (the one format for now)")->required();
+  export_cmd->add_option("--out,-o", export_out, "the XDMF file (default: RESULT.xdmf beside the run)");
+  std::string animate_run, animate_out, animate_colour = "speed";
+  int animate_fps = 12, animate_dpi = 100;
+  bool animate_quiet = false;
+  CLI::App* animate_cmd = app.add_subcommand("animate", "write a film of a run (matplotlib and ffmpeg), with a progress line");
+  animate_cmd->add_option("run", animate_run, "a run's output, RESULT.h5")->required();
+  animate_cmd->add_option("--out,-o", animate_out, "the film (default: RESULT.mp4 beside the run; .gif also works)");
+  animate_cmd->add_option("--colour", animate_colour, "colour floes by their speed, or by the contact force they carry")
+      ->check(CLI::IsMember({"speed", "force"}))
+      ->capture_default_str();
+  animate_cmd->add_option("--fps", animate_fps, "frames a second of film")->check(CLI::PositiveNumber)->capture_default_str();
+  animate_cmd->add_option("--dpi", animate_dpi, "resolution")->check(CLI::Range(10, 1000))->capture_default_str();
+  animate_cmd->add_flag("--quiet,-q", animate_quiet, "no progress line");
+
   floedem::BenchCommand bench_options;
   CLI::App* bench = floedem::add_bench_command(app, bench_options);
 
@@ -129,6 +150,20 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (field->parsed()) return floedem::run_field_command(field_options);
+    if (export_cmd->parsed()) {
+      std::vector<std::string> args{"export", export_run, "--xdmf"};
+      if (!export_out.empty()) args.insert(args.end(), {"--out", export_out});
+      const int status = floedem::run_python_module(args);
+      return status < 0 ? 1 : status;
+    }
+    if (animate_cmd->parsed()) {
+      std::vector<std::string> args{"animate", animate_run, "--colour", animate_colour, "--fps",
+                                    std::to_string(animate_fps), "--dpi", std::to_string(animate_dpi)};
+      if (!animate_out.empty()) args.insert(args.end(), {"--out", animate_out});
+      if (animate_quiet) args.emplace_back("--quiet");
+      const int status = floedem::run_python_module(args);
+      return status < 0 ? 1 : status;
+    }
     if (bench->parsed()) return floedem::run_bench_command(bench_options);
     if (report->parsed()) {
       // Exit status as the script's: 0 agreement, 5 disagreement, 4 a run failed.

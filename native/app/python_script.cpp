@@ -3,6 +3,7 @@
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -10,20 +11,30 @@ extern char** environ;
 
 namespace floedem {
 
-int run_python_script(const std::string& script, const std::vector<std::string>& args) {
+namespace {
+
+/// Runs Python with `argv` (after the interpreter), share/floedem/python first on its module
+/// path: the package the scripts and `python3 -m floedem` use is the one beside this command.
+int run_python(const std::string& what, std::vector<std::string> args) {
   const std::string python = FLOEDEM_PYTHON_EXE;
   if (python.empty()) {
-    std::cerr << "floedem: error: " << script
+    std::cerr << "floedem: error: " << what
               << " needs Python 3 with numpy, h5py and matplotlib, which the build did not find\n";
     return -1;
   }
   const std::string dir = data_dir();
   if (dir.empty()) {
-    std::cerr << "floedem: error: cannot find share/floedem (the report's scripts) beside " << own_executable()
-              << " or above it; install with `cmake --install` or run the command from its build directory\n";
+    std::cerr << "floedem: error: cannot find share/floedem (the report's scripts, the Python package) beside "
+              << own_executable() << " or above it; install with `cmake --install` or run the command from its "
+              << "build directory\n";
     return -1;
   }
-  std::vector<std::string> all{python, dir + "/reports/" + script};
+  const char* old = std::getenv("PYTHONPATH");
+  const std::string path = dir + "/python" + (old && *old ? ":" + std::string(old) : std::string());
+  setenv("PYTHONPATH", path.c_str(), 1);
+  for (std::string& a : args)
+    if (a.rfind("@DATA@", 0) == 0) a = dir + a.substr(6);
+  std::vector<std::string> all{python};
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : all) argv.push_back(a.data());
@@ -37,6 +48,20 @@ int run_python_script(const std::string& script, const std::vector<std::string>&
   waitpid(pid, &status, 0);
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+}  // namespace
+
+int run_python_script(const std::string& script, const std::vector<std::string>& args) {
+  std::vector<std::string> all{"@DATA@/reports/" + script};
+  all.insert(all.end(), args.begin(), args.end());
+  return run_python(script, all);
+}
+
+int run_python_module(const std::vector<std::string>& args) {
+  std::vector<std::string> all{"-m", "floedem"};
+  all.insert(all.end(), args.begin(), args.end());
+  return run_python("the floedem Python package", all);
 }
 
 std::string data_dir() {

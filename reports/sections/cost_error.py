@@ -24,7 +24,7 @@ import math
 import os
 import re
 
-import h5py
+import floedem
 import numpy as np
 
 from report_runner import Run
@@ -92,10 +92,9 @@ def plan(ctx):
 
 
 def impact_error(path):
-    with h5py.File(path, "r") as f:
-        m = f["bodies/mass"][:]
-        v = f["bodies/velocity"]
-        v0, v1 = v[0], v[-1]
+    with floedem.open(path) as f:
+        m = f.bodies.mass
+        v0, v1 = f.velocity[0], f.velocity[-1]
         e = float(re.search(r"^restitution\s*=\s*([0-9.eE+-]+)", f.attrs["scenario"], re.M).group(1))
     approach = abs(v0[0, 0] - v0[1, 0])
     ma, mb = m[0], m[1]
@@ -107,11 +106,11 @@ def impact_error(path):
 
 
 def drift_error(path):
-    with h5py.File(path, "r") as f:
-        t = f["time"][:]
-        p = f["bodies/position"][:, 0, :]
-        mass = f["bodies/mass"][0]
-        area = f["bodies/area"][0]
+    with floedem.open(path) as f:
+        t = f.time
+        p = f.position[:, 0, :]
+        mass = f.bodies.mass[0]
+        area = f.bodies.area[0]
     # The scenario's constants (free_drift_analytic.toml): K = rho_w C_dw A U_ref.
     a = 1025.0 * 0.005 * area * 0.1 / mass
     fc = 2.0 * CORIOLIS_OMEGA * math.sin(math.radians(75.0))
@@ -122,7 +121,7 @@ def drift_error(path):
 
 
 def towing_mean(path, s_stat):
-    with h5py.File(path, "r") as f:
+    with floedem.open(path) as f:
         t, _, ice, x = towing.tow_series(f)
     keep = towing.window(t, x, s_stat)
     return float(np.mean(ice[keep])), towing.block_se(t[keep], ice[keep])

@@ -1,5 +1,5 @@
 """The software versions and every setting of every engine, as each run recorded them."""
-import h5py
+import floedem
 
 
 def plan(ctx):
@@ -15,8 +15,8 @@ def write(ctx):
           "As recorded in the towing runs' root and `/engine` attributes (every setting in force).", ""]
     for e in ctx.engines:
         run = ctx.run(f"towing_{e}")
-        with h5py.File(run.out, "r") as f:
-            a = f["engine"].attrs
+        with floedem.open(run.out) as f:
+            a = f.engine_info
             md += [f"### {e}: {text(f.attrs['engine_version'])}", "",
                    f"floedem {text(f.attrs['floedem_version'])}; forcing terms: {text(f.attrs['forcing_terms'])}.", "",
                    "| setting | value |", "|---|---|"]

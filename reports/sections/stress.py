@@ -18,7 +18,7 @@ would add 1 % over 10^4 steps; inelastic contacts and friction only ever take en
 import math
 import os
 
-import h5py
+import floedem
 import numpy as np
 
 from report_runner import Run
@@ -134,29 +134,29 @@ class Outcome:
             self.reasons.append(code + (" (non-finite state)" if code == "exit 4" else ""))
             self.penetration = math.nan
             return
-        with h5py.File(run.out, "r") as f:
-            a = f.attrs
-            self.penetration = float(a["summary_max_penetration"])
-            self.speed = float(a["summary_max_speed"])
-            self.energy_ratio = float(a["summary_max_kinetic_energy"] / a["summary_kinetic_energy_start"]) \
-                if m["unforced"] and a["summary_kinetic_energy_start"] > 0 else math.nan
-            self.contact_work = float(a["summary_contact_work"])
-            self.step_gain = float(a["summary_max_relative_energy_gain"])
+        with floedem.open(run.out) as f:
+            a = f.summary
+            self.penetration = float(a["max_penetration"])
+            self.speed = float(a["max_speed"])
+            self.energy_ratio = float(a["max_kinetic_energy"] / a["kinetic_energy_start"]) \
+                if m["unforced"] and a["kinetic_energy_start"] > 0 else math.nan
+            self.contact_work = float(a["contact_work"])
+            self.step_gain = float(a["max_relative_energy_gain"])
             self.wall = run.seconds
             self.escaped = 0
             if "inside" in m:
                 x0, x1, y0, y1 = m["inside"]
-                moving = ~f["bodies/fixed"][:].astype(bool)
-                p = f["bodies/position"][-1]
+                moving = ~f.bodies.fixed.astype(bool)
+                p = f.position[-1]
                 out = (p[:, 0] < x0) | (p[:, 0] > x1) | (p[:, 1] < y0) | (p[:, 1] > y1)
                 self.escaped = int(np.count_nonzero(out & moving))
             self.load = None
-            if "loads" in f:
+            if f.loads is not None:
                 # The ice load on the first listed body (the grounded iceberg, the column's wall)
                 # over the run's second half: its mean and its scatter (jitter) about the mean, 1 s
                 # means.
-                t = f["loads/time"][:]
-                fx = f["loads/force"][:, 0, 0]
+                t = f.loads.time
+                fx = f.loads.force[:, 0, 0]
                 late = t >= 0.5 * t[-1]
                 self.load = (float(np.mean(fx[late])), float(np.std(fx[late])))
         limit = PENETRATION_FRACTION * m["thickness"]

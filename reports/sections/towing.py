@@ -10,9 +10,10 @@ not)."""
 import math
 import os
 
-import h5py
 import numpy as np
 
+import floedem
+from floedem.stats import block_standard_error, stationary_window, summary
 from report_runner import Run
 
 SCENARIO = "towing_paper.toml"
@@ -101,38 +102,27 @@ def plan(ctx):
 # Reading
 
 
-def tow_series(f):
-    """/tow of an open run file: time, towing force along x (N), its ice part along x (N), path
+def tow_series(run):
+    """/tow of a run (floedem.Run): time, towing force along x (N), its ice part along x (N), path
     position x (m)."""
-    g = f["tow"]
-    return g["time"][:], g["force_mean"][:, 0], g["ice_force_mean"][:, 0], g["tug_position"][:, 0]
+    g = run.tow
+    return g.time, g.force_mean[:, 0], g.ice_force_mean[:, 0], g.tug_position[:, 0]
 
 
 def window(t, tug_x, s_stat):
     """Rows of the stationary part: after s_stat metres of travel (row 0 has no step yet)."""
-    moved = tug_x - tug_x[0]
-    start = np.argmax(moved >= s_stat)
-    if moved[start] < s_stat:
-        raise RuntimeError(f"the iceberg never travelled {s_stat} m")
-    keep = np.zeros(len(t), bool)
-    keep[max(start, 1):] = True
-    return keep
+    try:
+        return stationary_window(tug_x, s_stat)
+    except ValueError as e:
+        raise RuntimeError(str(e)) from None
 
 
 def block_se(t, x):
     """Standard error of the mean of x from BLOCK-long block means."""
-    dt = t[1] - t[0] if len(t) > 1 else 1.0
-    per = max(1, int(round(BLOCK / dt)))
-    n = len(x) // per
-    if n < 2:
-        return float("nan")
-    means = x[: n * per].reshape(n, per).mean(axis=1)
-    return float(means.std(ddof=1) / math.sqrt(n))
+    return block_standard_error(t, x, BLOCK)
 
 
-def stats(x):
-    return dict(mean=float(np.mean(x)), std=float(np.std(x)), peak=float(np.max(x)),
-                p50=float(np.percentile(x, 50)), p90=float(np.percentile(x, 90)), p99=float(np.percentile(x, 99)))
+stats = summary
 
 
 class Case:
@@ -142,30 +132,30 @@ class Case:
         self.run = run
         self.file = os.path.relpath(run.out, rel_to)
         self.wall = run.seconds   # the run's wall time as the report measured it (process start to end)
-        with h5py.File(run.out, "r") as f:
+        with floedem.open(run.out) as f:
             self.t, self.force, self.ice, self.x = tow_series(f)
             self.keep = window(self.t, self.x, s_stat)
             self.t_stat = float(self.t[self.keep][0])
             self.force_stats = stats(self.force[self.keep])
             self.ice_stats = stats(self.ice[self.keep])
             self.ice_se = block_se(self.t[self.keep], self.ice[self.keep])
-            self.steps = int(f.attrs["summary_steps"])
-            ev = f["contacts/collisions"]
-            time = ev["time"][:]
-            on_berg = (ev["body_a"][:] == 0) | (ev["body_b"][:] == 0)
+            self.steps = int(f.summary["steps"])
+            ev = f.collisions
+            time = ev.time
+            on_berg = (ev.body_a == 0) | (ev.body_b == 0)
             late = time >= self.t_stat
             self.collisions = int(np.count_nonzero(late))
             self.berg_collisions = int(np.count_nonzero(late & on_berg))
-            peaks = ev["peak_force"][:]
+            peaks = ev.peak_force
             self.berg_peak_collision = float(peaks[late & on_berg].max()) if np.any(late & on_berg) else 0.0
             self.stat_seconds = float(self.t[-1] - self.t_stat)
-            fa = f["field"].attrs
+            fa = f.provenance["field"]
             self.concentration = float(fa["concentration_achieved"])
             first = int(fa["first_floe"])
-            self.thickness = float(np.mean(f["bodies/thickness"][first:]))
-            self.density = float(np.mean(f["bodies/density"][first:]))
+            self.thickness = float(np.mean(f.bodies.thickness[first:]))
+            self.density = float(np.mean(f.bodies.density[first:]))
             self.floes = int(fa["floes"])
-            verts = f["bodies/polygon_vertices"][: int(f["bodies/polygon_offsets"][1])]
+            verts = f.local_polygons()[0]
             self.width = float(verts[:, 1].max() - verts[:, 1].min())   # the iceberg (body 0) across the tow
             self.scenario_text = f.attrs["scenario"]
 
@@ -194,7 +184,7 @@ def write(ctx):
     md = ["## Towing forces: the paper's case", ""]
     engines = [Case(ctx.run(f"towing_{e}"), c["s_stat"], rel) for e in ctx.engines]
     base = engines[0]
-    with h5py.File(ctx.run("towing_open_water").out, "r") as f:
+    with floedem.open(ctx.run("towing_open_water").out) as f:
         ow = tow_series(f)
     ow_keep = window(ow[0], ow[3], c["s_stat"])
     drag = float(np.mean(ow[1][ow_keep]))
@@ -374,10 +364,9 @@ def write(ctx):
 
 
 def drift_track(path):
-    with h5py.File(path, "r") as f:
-        names = [n.decode() if isinstance(n, bytes) else n for n in f["bodies/name"][:]]
-        i = names.index("iceberg")
-        return f["time"][:], f["bodies/position"][:, i, :], f["bodies/velocity"][:, i, :]
+    with floedem.open(path) as f:
+        i = list(f.bodies.name).index("iceberg")
+        return f.time, f.position[:, i, :], f.velocity[:, i, :]
 
 
 def drift_section(ctx, c, plt):

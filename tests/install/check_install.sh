@@ -42,3 +42,13 @@ cd "$work/run"
 "$work/examples/scene_in_code" "$work/run/scene.h5"
 "$work/examples/own_engine"
 echo "install: both examples built against $prefix and ran"
+
+# The Python package: beside the command (floedem export runs it from there), and, for an
+# install into the user base (the README's `--prefix ~/.local`), importable by python3 alone.
+"$prefix/bin/floedem" export "$work/run/floe_floe_headon.native.h5" --xdmf >/dev/null
+[[ -f "$work/run/floe_floe_headon.native.xdmf" ]]
+python="${FLOEDEM_PYTHON:-/usr/bin/python3}"
+PYTHONUSERBASE="$work/userbase" cmake --install "$build" --prefix "$work/userbase" >/dev/null
+(cd "$work/run" && PYTHONUSERBASE="$work/userbase" "$python" -c \
+  "import floedem, sys; r = floedem.open('floe_floe_headon.native.h5'); sys.exit(len(r.bodies) != 2)")
+echo "install: the Python package imports from the user base and runs through the installed command"

@@ -1,0 +1,48 @@
+"""The Python half of `floedem export` and `floedem animate` (the floedem command runs it as
+`python3 -m floedem ...`); usable alone the same way. Exit codes as the command's: 2 bad input,
+3 the output cannot be written."""
+import argparse
+import sys
+
+from .run import FileError
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="floedem", description="floedem's results: export and films")
+    sub = ap.add_subparsers(dest="command", required=True)
+    ex = sub.add_parser("export", help="write a run as XDMF for ParaView, beside it (RUN.xdmf and RUN.xdmf.h5)")
+    ex.add_argument("run", help="a run's output, RESULT.h5")
+    ex.add_argument("--xdmf", action="store_true", required=True, help="XDMF (the one format for now)")
+    ex.add_argument("--out", "-o", help="the XDMF file (default: RESULT.xdmf beside the run)")
+    an = sub.add_parser("animate", help="write a film of a run (ffmpeg)")
+    an.add_argument("run", help="a run's output, RESULT.h5")
+    an.add_argument("--out", "-o", help="the film (default: RESULT.mp4 beside the run; .gif also works)")
+    an.add_argument("--colour", choices=["speed", "force"], default="speed",
+                    help="colour floes by speed, or by the contact force they carry (from /contacts)")
+    an.add_argument("--fps", type=int, default=12, help="frames a second of film (default 12)")
+    an.add_argument("--dpi", type=int, default=100, help="resolution (default 100)")
+    an.add_argument("--quiet", "-q", action="store_true", help="no progress line")
+    a = ap.parse_args(argv)
+    target = a.out or a.run
+    try:
+        if a.command == "export":
+            from .xdmf import export
+            print(export(a.run, a.out))
+        else:
+            from .animate import animate
+            if a.fps < 1 or a.dpi < 10:
+                raise FileError(f"--fps {a.fps}, --dpi {a.dpi}: allowed --fps >= 1 and --dpi >= 10")
+            out = a.out or (a.run[:-3] if a.run.endswith(".h5") else a.run) + ".mp4"
+            target = out
+            print(animate(a.run, out, a.colour, a.fps, a.dpi, progress=not a.quiet))
+    except FileError as e:
+        print(f"floedem: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:
+        print(f"floedem: output error: {target}: cannot write it ({e.strerror or e})", file=sys.stderr)
+        return 3
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
