@@ -33,6 +33,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/reports/ DESTINATION ${FLOEDEM_DATA_DIR}
   FILES_MATCHING PATTERN "*.py" PATTERN "latest" EXCLUDE PATTERN "bench" EXCLUDE PATTERN "threads-*" EXCLUDE
   PATTERN "__pycache__" EXCLUDE)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenarios/ DESTINATION ${FLOEDEM_DATA_DIR}/scenarios)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/profiles/ DESTINATION ${FLOEDEM_DATA_DIR}/profiles)
 # The Python package: beside the command (which runs `python3 -m floedem` from there), with its
 # pyproject.toml (pip install PREFIX/share/floedem/python), and where the Python that found
 # numpy and h5py looks for packages of this prefix (cmake/python_site.py), so that

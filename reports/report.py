@@ -41,6 +41,8 @@ class Context:
         self.scenarios = os.path.join(ROOT, "scenarios")
         self.engines = engines          # native first
         self.all_runs = []
+        self.jobs = a.jobs              # runs at a time
+        self.launch_seconds = 0.0       # wall time of launching every run (report_runner.run_all)
 
     def run(self, tag):
         for r in self.all_runs:
@@ -74,7 +76,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "results", "report"))
     ap.add_argument("--quick", action="store_true",
                     help="the same sections on smaller and shorter cases (the CI cross-check, a few minutes)")
-    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time (default: the cores)")
+    ap.add_argument("--jobs", type=int, default=len(os.sched_getaffinity(0)),
+                    help="runs at a time (default: the CPUs this process may use)")
     names = [s.__name__.split(".")[-1] for s in SECTIONS]
     ap.add_argument("--only", default="",
                     help=f"a partial report of these sections alone, comma-separated ({', '.join(names)})")
@@ -115,7 +118,9 @@ def main():
             ctx.all_runs.append(r)
     print(f"report: {len(ctx.all_runs)} runs on {', '.join(engines)}, {a.jobs} at a time, into {ctx.runs_dir}",
           flush=True)
+    launch_start = time.monotonic()
     failed = run_all(ctx.all_runs, a.floedem, ctx.runs_dir, a.jobs, "report")
+    ctx.launch_seconds = time.monotonic() - launch_start
     # The stress suite's runs may fail (a non-finite state is one of its outcomes): not an error.
     failed = [r for r in failed if not r.meta.get("may_fail")]
     if failed:

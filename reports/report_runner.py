@@ -1,12 +1,12 @@
-"""Runs of `floedem run` for the report: what to run (Run), and running a list of them in
-parallel with a progress line per finished run. A run that fails stops nothing else; its
-error is kept and the caller decides (the report fails at the end, naming it)."""
-import concurrent.futures
+"""Runs of `floedem run` for the report: what to run (Run), and running a list of them through
+floedem.launch (Snakemake), with a progress line per finished run. A run that fails stops
+nothing else; its error is kept and the caller decides (the report fails at the end, naming it)."""
 import os
-import subprocess
 import sys
-import time
 from dataclasses import dataclass, field
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), "python"))
+from floedem.launch import Job, launch  # noqa: E402
 
 
 @dataclass
@@ -41,49 +41,34 @@ class Run:
 
 
 def run_all(runs, floedem, runs_dir, jobs, label="report"):
-    """Runs every Run (longest first, `jobs` at a time) into runs_dir, then the timing runs one
-    at a time. Prints one line per finished run. Returns the runs that failed."""
+    """Runs every Run into runs_dir through floedem.launch (Snakemake, the project's one way of
+    launching runs): `jobs` at a time, the longest first, then the timing runs one at a time,
+    alone. Prints one line per finished run. Returns the runs that failed."""
     os.makedirs(runs_dir, exist_ok=True)
     for r in runs:
         r.out = os.path.join(runs_dir, r.tag + (".csv" if r.timed else ".h5"))
         for stale in (r.out, r.out + ".partial"):
             if os.path.exists(stale):
                 os.remove(stale)
-    order = sorted([r for r in runs if not r.timed], key=lambda r: -r.cost)
-    timed = [r for r in runs if r.timed]
-    start = time.monotonic()
-    done = 0
+    cores = len(os.sched_getaffinity(0))
+    # Threads per run: runs made side by side share the cores; a timing is single-threaded
+    # unless it says otherwise (the thread-scaling runs), and shares the machine with nothing.
+    share = max(1, cores // max(1, jobs))
+    untimed = sorted([r for r in runs if not r.timed], key=lambda r: -r.cost)
+    todo = [Job(r.tag, r.command(floedem), threads=r.threads or share, priority=len(untimed) - k + 1000,
+                may_fail=True) for k, r in enumerate(untimed)]
+    ids = [j.id for j in todo]
+    todo += [Job(r.tag, r.command(floedem), threads=r.threads or 1, alone=True, after=ids, may_fail=True)
+             for r in runs if r.timed]
+    records, _ = launch(todo, runs_dir, cores=min(cores, max(1, jobs) * share), label=label)
     failed = []
-
-    cores = os.cpu_count() or 1
-
-    def one(r):
-        # Threads per run: runs made side by side share the cores; a timing is single-threaded
-        # unless it says otherwise (the thread-scaling runs).
-        env = dict(os.environ)
-        env["FLOEDEM_THREADS"] = str(r.threads or (1 if r.timed else max(1, cores // max(1, jobs))))
-        t0 = time.monotonic()
-        p = subprocess.run(r.command(floedem), capture_output=True, text=True, env=env)
-        r.seconds = time.monotonic() - t0
-        if p.returncode != 0:
-            r.error = f"exit {p.returncode}: {p.stderr.strip()}"
-        return r
-
-    def finished():
-        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-            futures = [pool.submit(one, r) for r in order]
-            for future in concurrent.futures.as_completed(futures):
-                yield future.result()
-        for r in timed:   # alone: a timing shares the machine with nothing of ours
-            yield one(r)
-
-    for r in finished():
-        done += 1
-        status = "ok" if not r.error else ("failed" if r.meta.get("may_fail") else "FAILED")
-        print(f"[{label} {done:4d}/{len(runs)}] {r.seconds:7.1f} s  {status:6s} {r.tag} ({r.engine})"
-              f"   elapsed {time.monotonic() - start:6.0f} s", flush=True)
-        if r.error and not r.meta.get("may_fail"):
-            print(f"    {' '.join(r.command(floedem))}\n    {r.error}", file=sys.stderr, flush=True)
+    for r in runs:
+        rec = records.get(r.tag)
+        if rec is None:
+            r.error = "not run (its job did not finish)"
+        else:
+            r.seconds = rec["seconds"]
+            r.error = f"exit {rec['returncode']}: {rec['error']}" if rec["returncode"] else ""
         if r.error:
             failed.append(r)
     return failed

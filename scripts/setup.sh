@@ -11,6 +11,8 @@ packages=(
   python3 python3-numpy python3-h5py python3-matplotlib python3-pytest
   # Films (floedem animate) and ParaView's reader, which the tests read the XDMF export back with.
   ffmpeg python3-paraview
+  # Sweeps and the report's runs are launched by Snakemake.
+  snakemake
 )
 
 missing=()

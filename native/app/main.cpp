@@ -106,7 +106,32 @@ int main(int argc, char** argv) {
   report->add_option("--jobs,-j", report_jobs, "runs at a time (default: the number of cores)")
       ->check(CLI::PositiveNumber);
 
+  // floedem check: the scenario loaded, overrides applied and each engine built, as a run would,
+  // and nothing run (a sweep checks every point with it before it starts).
+  std::string check_scenario;
+  std::vector<std::string> check_overrides, check_engines;
+  CLI::App* check = app.add_subcommand(
+      "check", "check a scenario with its overrides on engines, as a run would, without running it (exit 2 and one line when it is refused)");
+  check->add_option("scenario", check_scenario, "scenario file (TOML)")->required();
+  check->add_option("--set,-s", check_overrides, "override a scalar of the scenario, KEY=VALUE; repeatable")
+      ->allow_extra_args(false);
+  check->add_option("--engine,-e", check_engines, "an engine to build the scene on; repeatable (default native)")
+      ->allow_extra_args(false);
+
   // The Python package's commands (python/floedem): the command parses, the package does the work.
+  std::string sweep_spec, sweep_out, sweep_profile;
+  int sweep_jobs = 0;
+  bool sweep_dry = false;
+  CLI::App* sweep = app.add_subcommand(
+      "sweep", "run a sweep file's parameter points, seeds and engines through Snakemake, then reduce them to one table "
+               "(docs/sweeps.md)");
+  sweep->add_option("spec", sweep_spec, "sweep file (TOML)")->required();
+  sweep->add_option("--out,-o", sweep_out, "the sweep's directory (its runs, their summaries, the reduced table)")
+      ->required();
+  sweep->add_option("--jobs,-j", sweep_jobs, "cores for the runs at a time (default: the CPUs this process may use)")
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--profile", sweep_profile, "a Snakemake profile (a cluster: the repository's profiles/slurm)");
+  sweep->add_flag("--dry-run,-n", sweep_dry, "check and plan, print what would run, run nothing");
   std::string export_run, export_out;
   bool export_xdmf = false;
   CLI::App* export_cmd = app.add_subcommand(
@@ -150,6 +175,21 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (field->parsed()) return floedem::run_field_command(field_options);
+    if (check->parsed()) {
+      const floedem::Scene scene = floedem::load_scenario(check_scenario, check_overrides);
+      if (check_engines.empty()) check_engines.emplace_back("native");
+      for (const std::string& e : check_engines) (void)floedem::make_engine(e, scene);
+      std::cout << check_scenario << ": ok (" << scene.bodies.size() << " bodies, " << scene.run.steps() << " steps)\n";
+      return 0;
+    }
+    if (sweep->parsed()) {
+      std::vector<std::string> args{"sweep", sweep_spec, "--out", sweep_out, "--floedem", floedem::own_executable()};
+      if (sweep_jobs > 0) args.insert(args.end(), {"--jobs", std::to_string(sweep_jobs)});
+      if (!sweep_profile.empty()) args.insert(args.end(), {"--profile", sweep_profile});
+      if (sweep_dry) args.emplace_back("--dry-run");
+      const int status = floedem::run_python_module(args);
+      return status < 0 ? 1 : status;
+    }
     if (export_cmd->parsed()) {
       std::vector<std::string> args{"export", export_run, "--xdmf"};
       if (!export_out.empty()) args.insert(args.end(), {"--out", export_out});

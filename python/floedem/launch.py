@@ -1,0 +1,122 @@
+"""How floedem launches runs, for the report and for sweeps alike: a list of jobs (a command
+each) run by Snakemake, on this machine (`cores` at a time) or on a cluster through a Snakemake
+profile. Each job is one rule of a Snakefile written for the list (its threads, its priority:
+the longest first, and what must finish before it); each leaves a record of its exit status and
+wall time in WORKDIR/.floedem/done/ID.json, so that a job done is never run again, and a list
+stopped half way and launched again runs only what is missing. A job whose command fails is
+retried (twice) unless it may fail (its failure is then recorded, not retried)."""
+import json
+import os
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+
+
+@dataclass
+class Job:
+    id: str                       # unique; letters, digits, '-', '_' and '.'
+    argv: list                    # the command
+    threads: int = 1              # cores it takes, and its FLOEDEM_THREADS
+    alone: bool = False           # nothing else runs beside it (a timing): it holds every core
+    priority: float = 0.0         # higher first (the report: its cost guess, longest first)
+    after: list = field(default_factory=list)   # ids of jobs that must finish before it
+    may_fail: bool = False        # a failure is an outcome (recorded, not retried)
+
+
+def _rule(job, index):
+    deps = ", ".join(f'".floedem/done/{a}.json"' for a in job.after)
+    threads = "workflow.cores" if job.alone else str(job.threads)
+    lines = [f"rule job{index}:",
+             f"    output: \".floedem/done/{job.id}.json\""]
+    if deps:
+        lines.append(f"    input: {deps}")
+    lines += [f"    threads: {threads}",
+              f"    priority: {int(job.priority)}",
+              f"    shell: \"{{PY}} -m floedem launch-one {{LAUNCH}} {job.id} --threads {{threads}}\""]
+    return "\n".join(lines)
+
+
+def write(jobs, workdir, label):
+    """WORKDIR/.floedem/launch.json and the Snakefile of the list."""
+    meta = os.path.join(workdir, ".floedem")
+    os.makedirs(os.path.join(meta, "done"), exist_ok=True)
+    ids = [j.id for j in jobs]
+    if len(set(ids)) != len(ids):
+        raise ValueError("launch: two jobs have the same id")
+    spec = dict(label=label, python=sys.executable, jobs=[asdict(j) for j in jobs])
+    path = os.path.join(meta, "launch.json")
+    with open(path + ".partial", "w") as f:
+        json.dump(spec, f)
+    os.replace(path + ".partial", path)
+    # Priorities: Snakemake orders ready jobs by them; rank the costs so that ties stay stable.
+    text = ["# Written by floedem (python/floedem/launch.py) for this list of jobs; rewritten at each launch.",
+            f"PY = {json.dumps(sys.executable)}", f"LAUNCH = {json.dumps(os.path.abspath(path))}", "",
+            "rule all:", "    input: [" + ", ".join(f'".floedem/done/{i}.json"' for i in ids) + "]", "",
+            "localrules: all", ""]
+    text += [_rule(j, k) + "\n" for k, j in enumerate(jobs)]
+    snakefile = os.path.join(meta, "Snakefile")
+    with open(snakefile + ".partial", "w") as f:
+        f.write("\n".join(text))
+    os.replace(snakefile + ".partial", snakefile)
+    return path, snakefile
+
+
+def launch(jobs, workdir, cores=None, profile=None, dry_run=False, label="launch", quiet=True):
+    """Runs the jobs not yet done; returns {id: record} for every job with a record (exit status,
+    wall time, error) and Snakemake's exit status."""
+    _, snakefile = write(jobs, workdir, label)
+    cores = cores or len(os.sched_getaffinity(0))
+    args = [sys.executable, "-m", "snakemake", "--snakefile", snakefile, "--directory", os.path.abspath(workdir),
+            "--rerun-incomplete", "--keep-going",
+            # A launch killed half way leaves Snakemake's lock behind: one launch at a time per
+            # directory, and no lock to clear by hand before the launch that finishes it.
+            "--nolock"]
+    if quiet and not dry_run:   # the progress lines are launch-one's; a dry run lists the jobs
+        args += ["--quiet", "all"]
+    if profile:
+        args += ["--profile", profile]
+    else:
+        args += ["--cores", str(cores), "--retries", "2"]
+    if dry_run:
+        args += ["--dry-run"]
+    status = subprocess.run(args).returncode
+    return records(jobs, workdir), status
+
+
+def records(jobs, workdir):
+    out = {}
+    for j in jobs:
+        for name in (j.id + ".json", j.id + ".failed.json"):
+            p = os.path.join(workdir, ".floedem", "done", name)
+            if os.path.exists(p):
+                with open(p) as f:
+                    out[j.id] = json.load(f)
+                break
+    return out
+
+
+def run_one(launch_json, job_id, threads):
+    """The workflow's rule: runs one job's command, records it, prints a progress line."""
+    with open(launch_json) as f:
+        spec = json.load(f)
+    job = next(j for j in spec["jobs"] if j["id"] == job_id)
+    done = os.path.join(os.path.dirname(launch_json), "done")
+    env = dict(os.environ, FLOEDEM_THREADS=str(max(1, job["threads"] if job["alone"] else threads)))
+    t0 = time.monotonic()
+    p = subprocess.run(job["argv"], capture_output=True, text=True, env=env)
+    seconds = time.monotonic() - t0
+    record = dict(returncode=p.returncode, seconds=seconds, error=(p.stderr or p.stdout).strip()[-2000:]
+                  if p.returncode else "")
+    ok = p.returncode == 0
+    target = os.path.join(done, job_id + (".json" if ok or job["may_fail"] else ".failed.json"))
+    with open(target + ".partial", "w") as f:
+        json.dump(record, f)
+    os.replace(target + ".partial", target)
+    count = len([n for n in os.listdir(done) if n.endswith(".json") and not n.endswith(".failed.json")])
+    status = "ok" if ok else ("failed" if job["may_fail"] else "FAILED")
+    print(f"[{spec['label']} {count:4d}/{len(spec['jobs'])}] {seconds:7.1f} s  {status:6s} {job_id}", flush=True)
+    if not ok and not job["may_fail"]:
+        print(f"    {' '.join(job['argv'])}\n    {record['error']}", file=sys.stderr, flush=True)
+        return p.returncode
+    return 0
