@@ -36,6 +36,34 @@ def block_standard_error(t, x, block):
     return float(means.std(ddof=1) / math.sqrt(n))
 
 
+def integrated_autocorrelation_time(x, dt=1.0, c=5.0):
+    """tau_int = dt (1/2 + sum_k rho(k)), the sum over lags k >= 1 cut at the first k >= c tau
+    (Sokal's automatic window, Sokal 1997; Madras and Sokal 1988): the time over which x stays
+    correlated. The variance of a mean of samples spanning T is about 2 tau_int var(x) / T."""
+    x = np.asarray(x, float) - np.mean(x)
+    n = len(x)
+    if n < 4 or not np.any(x):
+        return float(dt / 2.0)
+    f = np.fft.rfft(x, 2 * n)
+    acf = np.fft.irfft(f * np.conj(f))[:n]
+    rho = acf / acf[0]
+    tau = 0.5
+    for k in range(1, n):
+        tau += rho[k]
+        if k >= c * tau:
+            break
+    return float(max(tau, 0.5) * dt)
+
+
+def justified_block(t, x, factor=10.0):
+    """A block length for block_standard_error() from x's own correlation: factor times its
+    integrated autocorrelation time (blocks many correlation times long have nearly independent
+    means), at least one sample."""
+    t = np.asarray(t, float)
+    dt = t[1] - t[0] if len(t) > 1 else 1.0
+    return max(dt, factor * integrated_autocorrelation_time(x, dt))
+
+
 def summary(x):
     """Mean, standard deviation, peak, and the 50th, 90th and 99th percentiles."""
     x = np.asarray(x, float)
