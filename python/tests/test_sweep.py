@@ -164,3 +164,33 @@ def test_slurm_profile_jobs_run_through_sbatch(tmp_path):
                        env=env, capture_output=True, text=True)
     assert d.returncode == 0 and "job0 " in d.stdout + d.stderr
     assert len(log.read_text().splitlines()) == len(submitted)
+
+
+def test_a_killed_native_run_continues_from_its_checkpoint(tmp_path):
+    # Two floes, 6 000 steps with a frame each: a checkpoint follows the first 4 096 frames. The
+    # test hook kills every run at step 5 000 (SIGKILL, as a lost node would), so the first sweep
+    # fails after its retries; the second, without the hook, continues from the checkpoint.
+    scene = tmp_path / "two.toml"
+    scene.write_text('[run]\nduration = 60.0\ndt = 0.01\n[[body]]\nname = "a"\n'
+                     'polygon = [[0, 0], [10, 0], [10, 10], [0, 10]]\nthickness = 1.0\nvelocity = [0.2, 0.0]\n'
+                     '[[body]]\nname = "b"\npolygon = [[20, 0], [30, 0], [20, 12]]\nthickness = 1.0\n')
+    path = tmp_path / "sweep.toml"
+    path.write_text(f'scenario = "{scene}"\n[vary]\n"contact.restitution" = [0.1]\n'
+                    '[figures.ke]\nseries = "summary.kinetic_energy_end"\n')
+    out = tmp_path / "out"
+    command = os.environ.get("FLOEDEM", os.path.join(ROOT, "build", "floedem"))
+    killed = subprocess.run([command, "sweep", str(path), "--out", str(out)], capture_output=True, text=True,
+                            env=dict(os.environ, FLOEDEM_TEST_KILL_AT_STEP="5000"))
+    assert killed.returncode != 0
+    partial = list((out / "runs").glob("*.h5.partial"))
+    assert len(partial) == 1
+    with floedem.open(partial[0]) as p:
+        assert p.status == "running"
+    r = run_floedem("sweep", str(path), "--out", str(out))
+    summaries = list((out / "runs").glob("*.summary.json"))
+    assert len(summaries) == 1 and '"how": "resumed"' in summaries[0].read_text(), r.stdout
+    # The continued run is the uninterrupted one: the same final energy.
+    whole = tmp_path / "whole.h5"
+    run_floedem("run", "-q", str(scene), "-o", str(whole), "--set", "contact.restitution=0.1", "--set", "run.seed=1")
+    with floedem.open(whole) as a, floedem.open(out / "runs" / (summaries[0].name[:-len(".summary.json")] + ".h5")) as b:
+        np.testing.assert_array_equal(a.position[-1], b.position[-1])
