@@ -13,9 +13,11 @@ namespace floedem {
 
 namespace {
 
-/// Runs Python with `argv` (after the interpreter), share/floedem/python first on its module
-/// path: the package the scripts and `python3 -m floedem` use is the one beside this command.
-int run_python(const std::string& what, std::vector<std::string> args) {
+/// Runs Python with `args` after the interpreter (`script(dir)`, the first of them, made from
+/// the share/floedem found), share/floedem/python first on its module path: the package the
+/// scripts and `python3 -m floedem` use is the one beside this command.
+template <class First>
+int run_python(const std::string& what, First script, const std::vector<std::string>& args) {
   const std::string python = FLOEDEM_PYTHON_EXE;
   if (python.empty()) {
     std::cerr << "floedem: error: " << what
@@ -32,9 +34,9 @@ int run_python(const std::string& what, std::vector<std::string> args) {
   const char* old = std::getenv("PYTHONPATH");
   const std::string path = dir + "/python" + (old && *old ? ":" + std::string(old) : std::string());
   setenv("PYTHONPATH", path.c_str(), 1);
-  for (std::string& a : args)
-    if (a.rfind("@DATA@", 0) == 0) a = dir + a.substr(6);
   std::vector<std::string> all{python};
+  const std::vector<std::string> first = script(dir);
+  all.insert(all.end(), first.begin(), first.end());
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : all) argv.push_back(a.data());
@@ -53,15 +55,14 @@ int run_python(const std::string& what, std::vector<std::string> args) {
 }  // namespace
 
 int run_python_script(const std::string& script, const std::vector<std::string>& args) {
-  std::vector<std::string> all{"@DATA@/reports/" + script};
-  all.insert(all.end(), args.begin(), args.end());
-  return run_python(script, all);
+  return run_python(
+      script, [&](const std::string& dir) { return std::vector<std::string>{dir + "/reports/" + script}; }, args);
 }
 
 int run_python_module(const std::vector<std::string>& args) {
-  std::vector<std::string> all{"-m", "floedem"};
-  all.insert(all.end(), args.begin(), args.end());
-  return run_python("the floedem Python package", all);
+  return run_python(
+      "the floedem Python package", [](const std::string&) { return std::vector<std::string>{"-m", "floedem"}; },
+      args);
 }
 
 std::string data_dir() {
