@@ -123,9 +123,8 @@ class Run:
                                                   f"{'a newer' if newer else 'an older'} floedem wrote it")
         self.status = self.attrs.get("status", "")
         self.engine = self.attrs.get("engine", "")
-        for g in ("bodies",):
-            if g not in f:
-                raise self._error(f"/{g}", "missing; expected in every floedem file (docs/output.md)")
+        if "bodies" not in f:
+            raise self._error("/bodies", "missing; expected in every floedem file (docs/output.md)")
         self.bodies = Table(self, "bodies", _BODIES, {})
         n = len(self.bodies)
         offsets = f["bodies/polygon_offsets"][()] if "polygon_offsets" in f["bodies"] else None
