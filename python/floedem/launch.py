@@ -37,6 +37,14 @@ def _rule(job, index):
     return "\n".join(lines)
 
 
+def write_atomic(path, text):
+    """Writes text to path through PATH.partial and a rename, so that a reader (a resumed sweep,
+    Snakemake) never finds half a file under the final name."""
+    with open(path + ".partial", "w") as f:
+        f.write(text)
+    os.replace(path + ".partial", path)
+
+
 def write(jobs, workdir, label):
     """WORKDIR/.floedem/launch.json and the Snakefile of the list."""
     meta = os.path.join(workdir, ".floedem")
@@ -46,9 +54,7 @@ def write(jobs, workdir, label):
         raise ValueError("launch: two jobs have the same id")
     spec = dict(label=label, python=sys.executable, jobs=[asdict(j) for j in jobs])
     path = os.path.join(meta, "launch.json")
-    with open(path + ".partial", "w") as f:
-        json.dump(spec, f)
-    os.replace(path + ".partial", path)
+    write_atomic(path, json.dumps(spec))
     # Priorities: Snakemake orders ready jobs by them; rank the costs so that ties stay stable.
     text = ["# Written by floedem (python/floedem/launch.py) for this list of jobs; rewritten at each launch.",
             f"PY = {json.dumps(sys.executable)}", f"LAUNCH = {json.dumps(os.path.abspath(path))}", "",
@@ -56,9 +62,7 @@ def write(jobs, workdir, label):
             "localrules: all", ""]
     text += [_rule(j, k) + "\n" for k, j in enumerate(jobs)]
     snakefile = os.path.join(meta, "Snakefile")
-    with open(snakefile + ".partial", "w") as f:
-        f.write("\n".join(text))
-    os.replace(snakefile + ".partial", snakefile)
+    write_atomic(snakefile, "\n".join(text))
     return path, snakefile
 
 
@@ -110,9 +114,7 @@ def run_one(launch_json, job_id, threads):
                   if p.returncode else "")
     ok = p.returncode == 0
     target = os.path.join(done, job_id + (".json" if ok or job["may_fail"] else ".failed.json"))
-    with open(target + ".partial", "w") as f:
-        json.dump(record, f)
-    os.replace(target + ".partial", target)
+    write_atomic(target, json.dumps(record))
     count = len([n for n in os.listdir(done) if n.endswith(".json") and not n.endswith(".failed.json")])
     status = "ok" if ok else ("failed" if job["may_fail"] else "FAILED")
     print(f"[{spec['label']} {count:4d}/{len(spec['jobs'])}] {seconds:7.1f} s  {status:6s} {job_id}", flush=True)

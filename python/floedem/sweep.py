@@ -24,7 +24,7 @@ import numpy as np
 
 from . import figures as figs
 from . import tdist
-from .launch import Job, launch
+from .launch import Job, launch, write_atomic
 from .run import FileError, Run
 
 KEYS = {"scenario", "engines", "set", "vary", "seeds", "figures", "threads_per_run"}
@@ -146,7 +146,7 @@ def plan(spec, floedem):
     return jobs, version
 
 
-def check(spec, jobs, floedem):
+def check(spec, floedem):
     """Before any run: the engines are known, and `floedem check` accepts the first point on every
     engine and every other value of each key (on the first engine). SweepError naming the key."""
     code, listed = _floedem_text(floedem, "engines")
@@ -172,18 +172,14 @@ def check(spec, jobs, floedem):
 
 
 def _write_json(path, data):
-    tmp = path + ".partial"
-    with open(tmp, "w") as f:
-        json.dump(data, f, indent=1, sort_keys=True)
-        f.write("\n")
-    os.replace(tmp, path)
+    write_atomic(path, json.dumps(data, indent=1, sort_keys=True) + "\n")
 
 
 def prepare(spec_path, out, floedem):
     """Checks the sweep and writes OUT/sweep.json (what the workflow runs). Returns it."""
     spec = load(spec_path)
     jobs, version = plan(spec, floedem)
-    check(spec, jobs, floedem)
+    check(spec, floedem)
     try:
         os.makedirs(os.path.join(out, "runs"), exist_ok=True)
         probe = os.path.join(out, ".writable")
