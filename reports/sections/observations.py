@@ -9,12 +9,12 @@ conditions form a range, and the verdict is "overlaps" when the two ranges share
 count as a pass. Otherwise "outside", with the factor (or the difference, for angles) to the
 nearest end of the observed range.
 
-A miss is a result, not a failure: the report fails only on a regression, a row that passes in
-the committed verdicts (reports/observations_verdicts_quick.json for --quick,
-_full.json for the full report) and
-fails now. A row that passes now and is not recorded as passing is named, so that it can be
-recorded and held from then on: the report writes this run's verdicts to OUT/<the same name>,
-and copying that file over the committed one records them."""
+A miss is a result, not a failure: the report fails only on a regression, a row recorded as
+passing in the committed verdicts (reports/observations_verdicts_quick.json for --quick,
+reports/observations_verdicts_full.json for the full report) that fails now. A row that passes
+now and is not recorded as passing is named, so that it can be recorded and held from then on:
+the report writes this run's verdicts to OUT/ under the same name, and copying that file over
+the committed one records them."""
 import json
 import math
 import os
@@ -25,14 +25,7 @@ import floedem
 from floedem.launch import write_atomic
 from report_runner import Run
 
-HERE = os.path.dirname(os.path.realpath(__file__))
-REPORTS = os.path.dirname(HERE)
-
-
-def verdicts_name(quick):
-    """The file of committed verdicts of one kind of report, in reports/: {row id: "pass" | "miss"}."""
-    return f"observations_verdicts_{'quick' if quick else 'full'}.json"
-
+REPORTS = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))   # reports/, or share/floedem/reports
 WIND = 10.0            # m/s, wind_drift_barents.toml
 STORM = 15.0           # m/s, compaction_gulf.toml
 C_TAU = 1.5e-4         # s kg^-1/2, the default duration coefficient (include/floedem/scene/scene.hpp)
@@ -61,8 +54,7 @@ CAUSES = {
                          "sqrt(rho_a C_a A_sail / (rho_w C_w A_keel)), 0.020 in open water for this iceberg. floedem's "
                          "keel is the waterline polygon carried down to the draft: the published mass (927 000 t, "
                          "2.3 times the prism's) says the real keel is wider, and a wider keel drifts slower (the sensitivity "
-                         "table's C_w = 1.5 stands for a keel of 1.7 times the area). The surrounding "
-                         "floes drift slower than this iceberg and hold it back only a little.",
+                         "table's C_w = 1.5 stands for a keel of 1.7 times the area).",
     "drift_berg_deflection": "the deflection comes from Coriolis on the iceberg's mass (with added mass) against a "
                              "water drag along the relative velocity; the observed turning also carries the ocean "
                              "boundary layer's own turning, which the model does not have. Within a degree of the "
@@ -151,7 +143,7 @@ def plan(ctx):
     runs.append(Run("obs_compaction", scenario(ctx, "compaction_gulf"), "native", list(c["compaction"]), cost=30.0,
                     meta=dict(part="compaction")))
     engines = [e for e in ["native"] + COMPLIANT if e in ctx.engines]
-    # Weber: two equal square floes of 3 m, face to face at 0.05 m/s (m_eff = m / 2).
+    # Weber: two equal square floes 3 m thick, face to face at 0.05 m/s (m_eff = m / 2).
     for d, _ in WEBER_SIDES.items():
         s = disc_square(d * 1000.0)
         m = ICE_DENSITY * 3.0 * s * s
@@ -212,6 +204,13 @@ def wind_factor(u, wind):
     return float(np.hypot(u[0], u[1]) / wind), float(-math.degrees(math.atan2(u[1], u[0])))
 
 
+def pack_velocity(f):
+    """The floes' area-weighted mean velocity at each frame [T, 2]: the drift of the pack."""
+    a, b = f.field_range()
+    area = f.bodies.area[a:b]
+    return np.einsum("tnk,n->tk", f.velocity[:, a:b], area) / area.sum()
+
+
 def read_drift(run, window):
     """The iceberg's (body 0) and the floes' (area-weighted) wind factor and deflection over the
     last `window` seconds, the floes' spread (10th and 90th percentile of each floe's factor),
@@ -219,17 +218,16 @@ def read_drift(run, window):
     with floedem.open(run.out) as f:
         t, v, w = f.time, f.velocity, f.angular_velocity
         a, b = f.field_range()
-        area = f.bodies.area[a:b]
         keep = t >= t[-1] - window
-        floes = np.einsum("tn,n->t", v[:, a:b, 0], area) / area.sum(), np.einsum("tn,n->t", v[:, a:b, 1], area) / area.sum()
+        floes = pack_velocity(f)
         per_floe = np.hypot(*v[keep, a:b].mean(axis=0).T) / WIND
         return dict(
             berg=wind_factor(v[keep, 0].mean(axis=0), WIND),
-            floes=wind_factor((floes[0][keep].mean(), floes[1][keep].mean()), WIND),
+            floes=wind_factor(floes[keep].mean(axis=0), WIND),
             floe_spread=tuple(float(x) for x in np.percentile(per_floe, [10, 90])),
             omega_mean=float(np.abs(w[keep, 0]).mean()), omega_max=float(np.abs(w[:, 0]).max()),
             omega_max_late=float(np.abs(w[keep, 0]).max()),
-            t=t, berg_series=np.hypot(*v[:, 0].T) / WIND, floe_series=np.hypot(*floes) / WIND,
+            t=t, berg_series=np.hypot(*v[:, 0].T) / WIND, floe_series=np.hypot(*floes.T) / WIND,
             n_floes=b - a, window=(float(t[keep][0]), float(t[-1])))
 
 
@@ -238,11 +236,9 @@ def read_compaction(run, compacted_window):
     shore to that moment: the first load on the shore) and over the last `compacted_window`
     seconds, and the series."""
     with floedem.open(run.out) as f:
-        t, v = f.time, f.velocity
+        t = f.time
         a, b = f.field_range()
-        area = f.bodies.area[a:b]
-        pack = np.einsum("tnk,n->tk", v[:, a:b], area) / area.sum()
-        series = np.hypot(*pack.T) / STORM
+        series = np.hypot(*pack_velocity(f).T) / STORM
         lt = f.loads.time
         load = np.hypot(*f.loads.force[:, 0].T)
         touched = lt[load > 0.0]
@@ -295,6 +291,11 @@ def verdict(sim, obs, angle=False):
 
 def passes(v):
     return v in ("inside", "overlaps")
+
+
+def verdicts_name(quick):
+    """The file of committed verdicts of one kind of report, in reports/: {row id: "pass" | "miss"}."""
+    return f"observations_verdicts_{'quick' if quick else 'full'}.json"
 
 
 def load_verdicts(quick):
