@@ -21,7 +21,8 @@ import time
 HERE = os.path.dirname(os.path.realpath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from report_runner import run_all  # noqa: E402
+from report_runner import run_all  # noqa: E402  (it puts the floedem package on the path)
+from floedem.launch import write_atomic  # noqa: E402
 from sections import SECTIONS  # noqa: E402
 from sections.speed import load_stage_labels  # noqa: E402
 
@@ -154,10 +155,7 @@ def main():
         head += ["Every engine agrees with native, and native with the closed forms, within the tolerances stated "
                  "in each section."]
     head.append("")
-    tmp = report + ".partial"
-    with open(tmp, "w") as f:
-        f.write("\n".join(head + body) + "\n")
-    os.replace(tmp, report)
+    write_atomic(report, "\n".join(head + body) + "\n")
     for x in fails:
         print(f"report: DISAGREEMENT: {x}", file=sys.stderr)
     print(f"report: {report} ({len(fails)} disagreements, {total:.0f} s)", flush=True)

@@ -48,12 +48,23 @@ OBS = {
     "tow_force": (44e3, 311e3),
     "omega_mean": (2.0 * math.pi / 86400.0, 4.0 * math.pi / 86400.0), "omega_max": (0.0, 1e-3),
 }
+# Each range as the report's table prints it (in the quantity's unit there), beside the range above.
+OBS_TEXT = {
+    "floe_factor": "0.016 to 0.023", "floe_deflection": "-6 to +9",
+    "berg_factor": "0.010 to 0.015", "berg_deflection": "10 to 15",
+    "free_factor": "0.014 to 0.029", "compacted_factor": "0 (to 0.0005)",
+    "weber_duration": "20 to 40", "hans_peak": "300 to 600",
+    "gagnon_duration": "0.2 to 0.6", "gagnon_peak": "up to 2.4",
+    "tow_force": "44 to 311",
+    "omega_mean": "7.3e-5 to 1.5e-4 (1 to 2 turns a day)", "omega_max": "up to 1e-3",
+}
 # The likely cause of a miss, by row id: the model's assumption that the observation questions.
 CAUSES = {
     "drift_berg_factor": "the iceberg's wind factor is set by its sail's air drag against its keel's water drag, "
                          "sqrt(rho_a C_a A_sail / (rho_w C_w A_keel)), 0.020 in open water for this iceberg. floedem's "
                          "keel is the waterline polygon carried down to the draft: the published mass (927 000 t, "
-                         "2.3 times the prism's) says the real keel is wider, and a wider keel drifts slower (the sensitivity "
+                         "2.3 times the prism's) says the real keel is wider, and a wider keel drifts slower (the "
+                         "sensitivity "
                          "table's C_w = 1.5 stands for a keel of 1.7 times the area).",
     "drift_berg_deflection": "the deflection comes from Coriolis on the iceberg's mass (with added mass) against a "
                              "water drag along the relative velocity; the observed turning also carries the ocean "
@@ -343,11 +354,11 @@ def write(ctx):
     c = config(ctx.quick)
     rel = lambda r: os.path.relpath(r.out, ctx.out)  # noqa: E731
     engines = [e for e in ["native"] + COMPLIANT if e in ctx.engines]
-    rows = []   # (id, case, quantity, observed text, simulated text, verdict, how far, engine)
+    rows = []   # dicts: id, case, quantity, observed and simulated text, verdict, how far, engine
 
-    def row(rid, case, quantity, obs_text, sim, sim_text, obs, engine="native", angle=False):
-        v, how = verdict(sim, obs, angle)
-        rows.append(dict(id=rid, case=case, quantity=quantity, observed=obs_text, simulated=sim_text,
+    def row(rid, case, quantity, sim, sim_text, key, engine="native", angle=False):
+        v, how = verdict(sim, OBS[key], angle)
+        rows.append(dict(id=rid, case=case, quantity=quantity, observed=OBS_TEXT[key], simulated=sim_text,
                          verdict=v, how=how, engine=engine))
 
     # Case 1: wind drift.
@@ -356,19 +367,17 @@ def write(ctx):
     sens[0.9] = drift
     fl, fd = drift["floes"]
     bf, bd = drift["berg"]
-    row("drift_floe_factor", "1 Barents Sea drift", "floes: wind factor", "0.016 to 0.023", fl, f"{fl:.4f}",
-        OBS["floe_factor"])
-    row("drift_floe_deflection", "1 Barents Sea drift", "floes: deflection (deg)", "-6 to +9", fd, f"{fd:+.1f}",
-        OBS["floe_deflection"], angle=True)
-    row("drift_berg_factor", "1 Barents Sea drift", "iceberg: wind factor", "0.010 to 0.015", bf, f"{bf:.4f}",
-        OBS["berg_factor"])
-    row("drift_berg_deflection", "1 Barents Sea drift", "iceberg: deflection (deg)", "10 to 15", bd, f"{bd:+.1f}",
-        OBS["berg_deflection"], angle=True)
+    row("drift_floe_factor", "1 Barents Sea drift", "floes: wind factor", fl, f"{fl:.4f}", "floe_factor")
+    row("drift_floe_deflection", "1 Barents Sea drift", "floes: deflection (deg)", fd, f"{fd:+.1f}",
+        "floe_deflection", angle=True)
+    row("drift_berg_factor", "1 Barents Sea drift", "iceberg: wind factor", bf, f"{bf:.4f}", "berg_factor")
+    row("drift_berg_deflection", "1 Barents Sea drift", "iceberg: deflection (deg)", bd, f"{bd:+.1f}",
+        "berg_deflection", angle=True)
     comp = read_compaction(ctx.run("obs_compaction"), c["compacted_window"])
-    row("compaction_free", "1 Gulf of St Lawrence", "pack, free: wind factor", "0.014 to 0.029", comp["free"],
-        f"{comp['free']:.4f}", OBS["free_factor"])
-    row("compaction_arrest", "1 Gulf of St Lawrence", "pack against the shore: wind factor", "0 (to 0.0005)",
-        comp["compacted"], f"{comp['compacted']:.2g}", OBS["compacted_factor"])
+    row("compaction_free", "1 Gulf of St Lawrence", "pack, free: wind factor", comp["free"],
+        f"{comp['free']:.4f}", "free_factor")
+    row("compaction_arrest", "1 Gulf of St Lawrence", "pack against the shore: wind factor", comp["compacted"],
+        f"{comp['compacted']:.2g}", "compacted_factor")
 
     # Case 2: collisions.
     col = {}
@@ -377,29 +386,28 @@ def write(ctx):
             col[r.tag] = dict(read_collision(r), **r.meta)
     for e in engines:
         w = col[f"obs_weber_d3_{e}"]
-        row(f"weber_duration_{e}", "2 Weber 1972", "duration (s)", "20 to 40", w["duration"], f"{w['duration']:.1f}",
-            OBS["weber_duration"], e)
+        row(f"weber_duration_{e}", "2 Weber 1972", "duration (s)", w["duration"], f"{w['duration']:.1f}",
+            "weber_duration", e)
         h = col[f"obs_hans_d1.5_{e}"]
-        row(f"hans_peak_{e}", "2 Hans Island", "peak force, direct hit (MN)", "300 to 600", h["peak_force"],
-            si(h["peak_force"], 1e6), OBS["hans_peak"], e)
+        row(f"hans_peak_{e}", "2 Hans Island", "peak force, direct hit (MN)", h["peak_force"],
+            si(h["peak_force"], 1e6), "hans_peak", e)
         g = [col[f"obs_gagnon_m{m / 1e3:g}t_v{v:g}_{e}"] for m in GAGNON_MASSES for v in GAGNON_SPEEDS]
         dur = (min(x["duration"] for x in g), max(x["duration"] for x in g))
         peak = (min(x["peak_force"] for x in g), max(x["peak_force"] for x in g))
-        row(f"gagnon_duration_{e}", "2 Gagnon 2008", "duration (s)", "0.2 to 0.6", dur, fmt(dur), OBS["gagnon_duration"], e)
-        row(f"gagnon_peak_{e}", "2 Gagnon 2008", "peak force (MN)", "up to 2.4", peak, si(peak, 1e6),
-            OBS["gagnon_peak"], e)
+        row(f"gagnon_duration_{e}", "2 Gagnon 2008", "duration (s)", dur, fmt(dur), "gagnon_duration", e)
+        row(f"gagnon_peak_{e}", "2 Gagnon 2008", "peak force (MN)", peak, si(peak, 1e6), "gagnon_peak", e)
 
     # Case 3: towing in open water.
     tow = {(v, cw): read_tow(ctx.run(f"obs_tow_v{v:g}_cw{cw:g}")) for v in TOW_SPEEDS for cw in [0.9] + WATER_FORM}
     tow_range = (tow[(TOW_SPEEDS[0], 0.9)], tow[(TOW_SPEEDS[-1], 0.9)])
-    row("tow_open_water", "3 Labrador tows", "open-water towing force (kN), orders of magnitude", "44 to 311",
-        tow_range, si(tow_range, 1e3), OBS["tow_force"])
+    row("tow_open_water", "3 Labrador tows", "open-water towing force (kN), orders of magnitude", tow_range,
+        si(tow_range, 1e3), "tow_force")
 
     # Case 4: rotation of the drifting iceberg of case 1.
-    row("rotation_mean", "4 iceberg rotation", "iceberg: mean abs(omega) (rad/s)", "7.3e-5 to 1.5e-4 (1 to 2 turns a day)",
-        drift["omega_mean"], f"{drift['omega_mean']:.2g}", OBS["omega_mean"])
-    row("rotation_max", "4 iceberg rotation", "iceberg: largest abs(omega) (rad/s)", "up to 1e-3",
-        drift["omega_max"], f"{drift['omega_max']:.2g}", OBS["omega_max"])
+    row("rotation_mean", "4 iceberg rotation", "iceberg: mean abs(omega) (rad/s)", drift["omega_mean"],
+        f"{drift['omega_mean']:.2g}", "omega_mean")
+    row("rotation_max", "4 iceberg rotation", "iceberg: largest abs(omega) (rad/s)", drift["omega_max"],
+        f"{drift['omega_max']:.2g}", "omega_max")
 
     # Regressions against the committed verdicts.
     fails, newly = regressions(rows, load_verdicts(ctx.quick))
@@ -522,7 +530,8 @@ def write(ctx):
            "(Weber: 0.023 to 0.033 m/s); the scene's approach speed was chosen to give the middle of that range, so "
            "this checks the scene, not the model. The duration, which the model predicts, reaches 20 s at the default "
            f"C_tau for floes of {3.0 * 20.0 / w3['duration']:.1f} km (it goes as the floes' diameter, the square "
-           "root of their mass), and the floes' size is not published with the event. The bergy bits' peak forces exceed the largest measured (2.4 MN, on an "
+           "root of their mass), and the floes' size is not published with the event. The bergy bits' peak "
+           "forces exceed the largest measured (2.4 MN, on an "
            "instrumented panel of the bow) by far: one linear contact stiffness (4.4e8 N/m) for every scale is the "
            "model's assumption that fails here. A bergy bit crushes over a small, growing contact area, a much "
            "softer contact than the kilometre-scale floes the default was set from, and the panel carried only "
