@@ -56,4 +56,17 @@ FLOEDEM_LANES v4d sqrt4(v4d x) {
 #endif
 }
 
+// The operations solver/local_law.hpp asks of a lane type (its ScalarOps on four lanes).
+struct Ops {
+  using value = v4d;
+  using mask = v4m;
+  static constexpr bool lanes = true;
+  FLOEDEM_LANES static v4d select(v4m m, v4d a, v4d b) { return lanes4::select(m, a, b); }
+  FLOEDEM_LANES static v4m both(v4m a, v4m b) { return a & b; }
+  FLOEDEM_LANES static v4d absolute(v4d x) { return lanes4::abs(x); }
+  FLOEDEM_LANES static v4d splat(double x) { return lanes4::splat(x); }
+  FLOEDEM_LANES static v4m less(v4d a, v4d b) { return (v4m)(a < b); }
+  FLOEDEM_LANES static v4m less_equal(v4d a, v4d b) { return (v4m)(a <= b); }
+};
+
 }  // namespace floedem::lanes4

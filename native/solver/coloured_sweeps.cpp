@@ -15,12 +15,12 @@
 #include "geometry/lane_isa.hpp"
 #include "geometry/lanes4.hpp"
 #include "parallel/thread_pool.hpp"
+#include "solver/local_law.hpp"
 #include "solver/sweep_row.hpp"
 
 // The conditions each point's local solve meets, and the Delassus block, are stated in
-// contact_solver.cpp; the case-by-case solve is local_impulse (sweep_row.hpp), of which
-// local_lanes below is the same law with every case computed and the first that holds
-// selected, its divisions as multiplications by reciprocals.
+// contact_solver.cpp; the local solve is local_law (local_law.hpp), the one the sweeps in pair
+// order make, on four lanes.
 
 namespace floedem {
 
@@ -77,56 +77,10 @@ FLOEDEM_LANES Delassus delassus(const SweepBundle& b, const BundlePoint& p, v4d 
                         load(p.rby), nx, ny);
 }
 
-// local_impulse (sweep_row.hpp) on four lanes: each case's impulse computed, then the first
-// case that holds, in local_impulse's order, selected. Its divisions are multiplications by
-// reciprocals (1 / (W_nn W_tt - W_nt^2), 1 / W_nn, 1 / W_tt, 1 / (W_nn -+ mu W_nt), the last
-// two NaN where the divisor is not positive: that slide never holds), so the impulses differ
-// from local_impulse's by rounding. A lane without a point (target -inf) is apart whatever its
-// block: its impulse is zero.
+// local_law (local_law.hpp) on four lanes. A lane without a point (target -inf) is apart
+// whatever its block: its impulse is zero.
 FLOEDEM_LANES void local_lanes(const BundlePoint& p, const Delassus& d, v4d ufn, v4d uft, v4d mu, v4d& pn, v4d& pt) {
-  // Written so that few values are live at once (the Side velocities, the normal and the sweep's
-  // maxima hold most of the sixteen registers of AVX2): each case, from the last to the first,
-  // computed and selected in turn.
-  const v4d zero = splat(0.0), one = splat(1.0);
-  const v4d wnt = d.wnt;
-  const v4d need = load(p.target) - ufn;
-  // Neither slide nor stick: the frictionless normal impulse, friction clamped to the cone (std::clamp).
-  const v4d inv_wnn = one / d.wnn;
-  pn = need * inv_wnn;
-  {
-    const v4d want = -(uft + wnt * pn) * (one / d.wtt);
-    const v4d cone = mu * pn;
-    pt = select((v4m)(want < -cone), -cone, select((v4m)(cone < want), cone, want));
-  }
-  // Stick: W (P_n, P_t) = (need, -u_t).
-  const v4d inv_det = one / (d.wnn * d.wtt - wnt * wnt);
-  const v4d pt_stick = (-d.wnn * uft - wnt * need) * inv_det;
-  // Slide with slip direction s: P_t = -s mu P_n, (W_nn - s mu W_nt) P_n = need, consistent if
-  // s u_t+ >= 0 (to rounding). Tried first with s = -1 where stick wanted P_t > 0, else s = +1.
-  const v4m minus_first = (v4m)(pt_stick > zero);
-  const v4d slack = splat(-1e-14) * (abs(uft) + abs(need));
-  auto slide = [&](v4d s, v4d inv_denominator) {
-    const v4d slide_pn = need * inv_denominator;  // NaN where the divisor is not positive: never holds
-    const v4m holds = (v4m)(s * (uft + (wnt - s * mu * d.wtt) * slide_pn) >= slack);
-    pn = select(holds, slide_pn, pn);
-    pt = select(holds, -s * mu * slide_pn, pt);
-  };
-  const v4d nan = splat(std::numeric_limits<double>::quiet_NaN());
-  const v4d slide_plus = d.wnn - mu * wnt, slide_minus = d.wnn + mu * wnt;  // s = +1, s = -1
-  const v4d plus = select((v4m)(slide_plus > zero), one / slide_plus, nan);
-  const v4d minus = select((v4m)(slide_minus > zero), one / slide_minus, nan);
-  slide(select(minus_first, one, -one), select(minus_first, plus, minus));  // the second try
-  slide(select(minus_first, -one, one), select(minus_first, minus, plus));  // the first
-  const v4d pn_stick = (d.wtt * need + wnt * uft) * inv_det;
-  const v4m stick = (v4m)(pn_stick >= zero) & (v4m)(abs(pt_stick) <= mu * pn_stick);
-  pn = select(stick, pn_stick, pn);
-  pt = select(stick, pt_stick, pt);
-  const v4m frictionless = (v4m)(mu <= zero);
-  pn = select(frictionless, need * inv_wnn, pn);
-  pt = select(frictionless, zero, pt);
-  const v4m apart = (v4m)(need <= zero);
-  pn = select(apart, zero, pn);
-  pt = select(apart, zero, pt);
+  local_law<lanes4::Ops>(ufn, uft, load(p.target), mu, d.wnn, d.wnt, d.wtt, pn, pt);
 }
 
 // What a sweep reports: its largest change |dP_n| + |dP_t| and impulse P_n + |P_t| (each
@@ -509,7 +463,7 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
       space.overflow[g.overflow++] = static_cast<std::int32_t>(i);  // i >= g.overflow: read already
       for (int k = 0; k < c.point_count; ++k) {
         const ManifoldPoint& q = c.points[k];
-        space.rows[g.rows++] = {c.body_a, c.body_b, c.normal, q.ra,  q.rb, q.wnn, q.wnt, q.wtt, q.target_velocity,
+        space.rows[g.rows++] = {c.body_a, c.body_b, c.normal, q.ra, q.rb, q.wnn, q.wnt, q.wtt, q.target_velocity,
                                 c.friction, q.normal_impulse, q.tangent_impulse};
         warm(q);
       }

@@ -16,8 +16,8 @@
 // only read (as apply_impulse) and take no colour. A body with more than 63 manifolds sends the
 // rest to a last group, one manifold a bundle, swept in order.
 //
-// It is another Gauss-Seidel order of the same points with the same local law (local_impulse,
-// sweep_row.hpp, its divisions as multiplications by reciprocals), so it converges to the
+// It is another Gauss-Seidel order of the same points with the same local law (local_law.hpp,
+// the pair order's, lane by lane: the same bits for the same inputs), so it converges to the
 // same solution; after a given number of sweeps its impulses differ from the pair order's (a
 // setting, not an optimisation of the default: results are not the pair order's to the bit).
 // Each lane's arithmetic is IEEE double, no fused multiply-add (CMakeLists), so the result is

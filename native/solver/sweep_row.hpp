@@ -8,39 +8,15 @@
 #include <span>
 
 #include "solver/contact_solver.hpp"
+#include "solver/local_law.hpp"
 
 namespace floedem {
 
-// Inlined into the sweep (called once per point per sweep; inlined, the towing case's sweeps
-// take about 3 % fewer instructions); the same arithmetic as a call, so the same impulses to the bit.
-[[gnu::always_inline]] inline LocalImpulse local_impulse(double ufn, double uft, double target, double mu, double wnn,
-                                                        double wnt, double wtt) {
-  const double need = target - ufn;  // normal velocity change wanted
-  if (need <= 0.0) return {};        // separating (or already fast enough): no impulse
-  if (mu <= 0.0) return {need / wnn, 0.0};
-
-  // Stick: u_n+ = u*, u_t+ = 0  =>  W (P_n, P_t) = (need, -u_t).
-  const double det = wnn * wtt - wnt * wnt;
-  const double pn_stick = (wtt * need + wnt * uft) / det;
-  const double pt_stick = (-wnn * uft - wnt * need) / det;
-  if (pn_stick >= 0.0 && std::abs(pt_stick) <= mu * pn_stick) return {pn_stick, pt_stick};
-
-  // Slide with final slip direction s (= sign u_t+): P_t = -s mu P_n, and
-  // (W_nn - s mu W_nt) P_n = need; consistent if P_n >= 0 and s u_t+ >= 0.
-  const double first = pt_stick > 0.0 ? -1.0 : 1.0;  // friction saturates on the side stick wanted
-  const double scale = std::abs(uft) + std::abs(need);
-  for (const double s : {first, -first}) {
-    const double denom = wnn - s * mu * wnt;
-    if (denom <= 0.0) continue;
-    const double pn = need / denom;
-    const double ut = uft + (wnt - s * mu * wtt) * pn;
-    if (s * ut >= -1e-14 * scale) return {pn, -s * mu * pn};
-  }
-  // No consistent case (Painleve-like configurations with strong coupling): the frictionless
-  // normal impulse with friction clamped to the cone.
-  const double pn = need / wnn;
-  const double pt = std::clamp(-(uft + wnt * pn) / wtt, -mu * pn, mu * pn);
-  return {pn, pt};
+/// The local law (local_law.hpp) on one point of its own (the impact suite's single contacts).
+inline LocalImpulse local_impulse(double ufn, double uft, double target, double mu, double wnn, double wnt, double wtt) {
+  LocalImpulse r;
+  local_law<ScalarOps>(ufn, uft, target, mu, wnn, wnt, wtt, r.normal, r.tangent);
+  return r;
 }
 
 /// Applies `impulse` (on the row's body b; its opposite on a) at the row's contact point.
@@ -72,7 +48,8 @@ struct RowChange {
   // Velocity without this point's own impulse.
   const double ufn = dot(u, n) - (p.wnn * pn0 + p.wnt * pt0);
   const double uft = dot(u, t) - (p.wnt * pn0 + p.wtt * pt0);
-  const LocalImpulse r = local_impulse(ufn, uft, p.target_velocity, p.friction, p.wnn, p.wnt, p.wtt);
+  LocalImpulse r;
+  local_law<ScalarOps>(ufn, uft, p.target_velocity, p.friction, p.wnn, p.wnt, p.wtt, r.normal, r.tangent);
   const double dpn = r.normal - pn0, dpt = r.tangent - pt0;
   if (dpn != 0.0 || dpt != 0.0) apply_row_impulse(s, p, dpn * n + dpt * t);
   p.normal_impulse = r.normal;
