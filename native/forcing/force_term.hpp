@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -144,16 +145,30 @@ class Forcing {
   bool works_on_moving_bodies_only() const { return moving_only_; }
   /// Loads for the step that starts at `time`, or nullptr when the scene has no forcing.
   /// `rotations`: each body's Rot::from_angle(angle), where the engine has them (Engine::
-  /// rotations); empty, the forcing makes them.
-  const Loads* evaluate(const BodyStates& state, double time, std::span<const Rot> rotations = {});
+  /// rotations); empty, the forcing makes them. `touching`: per body, nonzero where it had a
+  /// contact in the last step (its step is first order, its load exact: forcing.cpp); empty,
+  /// every body is taken to be free (second order).
+  const Loads* evaluate(const BodyStates& state, double time, std::span<const Rot> rotations = {},
+                        std::span<const std::uint8_t> touching = {});
+  /// Checkpoint: what the next step reads of the last (the accelerations of the free bodies).
+  void save(StateWriter& out) const;
+  void restore(StateReader& in);
   /// The generalised force of all terms on prescribed (towed) body i over the last evaluated
   /// step, Coriolis included (-m f k x v at its prescribed velocity). Towing reads it.
   std::array<double, 3> environment_force(std::size_t i) const;
 
  private:
-  /// Whether a body's drag Jacobian is stiff at this dt (then the step is linearly implicit).
-  bool stiff(const std::array<double, 9>& d, double mass, double inertia) const;
-  static constexpr double kExplicitLimit = 0.5;
+  /// The largest rate |D| / M of a body's drag Jacobian (1/s, row sums): h times it decides
+  /// whether its step is implicit (forcing.cpp).
+  static double drag_rate(const std::array<double, 9>& d, double mass, double inertia);
+  static constexpr double kExplicitLimit = 0.5;  ///< a step is explicit below this h |D| / M
+  /// Whether body i is free this step (no contact in the last).
+  bool free_body(std::size_t i) const { return touching_.empty() || touching_[i] == 0; }
+  std::span<const std::uint8_t> touching_;  ///< evaluate's `touching`, for the step under way
+  /// Per body, the acceleration (dv_x, dv_y, dw) / h the last step's forcing gave it where it
+  /// was free and explicit, else zero: the next step takes its terms at q + (dt/2) a.
+  std::vector<std::array<double, 3>> ahead_;
+  bool any_ahead_ = false;  ///< some entry of ahead_ is not zero
 
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   /// The run of consecutive drag terms terms_[pass_first_, pass_first_ + pass_count_) that

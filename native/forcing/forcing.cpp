@@ -1,23 +1,41 @@
 // Forcing: sums the terms and takes one linearly implicit step per body.
 //
 // Per body, with q = (v_x, v_y, omega), inertia M = diag(m_I, m_I, I_I) including added mass
-// (m_I = m (1 + C_m)), the terms' force Q(q_n), its Jacobian D = dQ/dq and a rotation rate f:
+// (m_I = m (1 + C_m)), the terms' force Q, its Jacobian D = dQ/dq and a rotation rate f:
 //
-//   M (q_n+1 - q_n) / dt = Q(q_n) + s D (q_n+1 - q_n) - C (q_n + q_n+1) / 2
+//   M (q_n+1 - q_n) / h = Q(q^) + s D (q_n+1 - q_n) - C (q_n + q_n+1) / 2
 //
-// where C q = m_I f~ (k x v, 0). Drag is explicit (s = 0) while dt is well below the body's
-// drag time scale (dt |D| / M < 0.5, where explicit Euler is stable and as accurate), and
-// linearly implicit (s = 1, Rosenbrock-Euler: stable at any dt) above it. Explicit is the
-// default because an implicit force is the force of a body that moves freely: a body held
-// still by contacts would see its drag under-reported by the factor 1 / (1 + dt |D| / M)
-// (0.2 % for a 10 m floe at dt = 0.05 s), and ice loads are what users read. Coriolis is trapezoidal (Cayley) with f~ = (2/dt) tan(f' dt / 2),
-// f' = f m / m_I, which turns the velocity by exactly f' dt per step: no drift of the speed
-// and no phase error, so the inertial circle closes (the requirement is 1e-4 of the radius after 10
-// periods at dt = 60 s). The first step turns by half of that: symplectic Euler is a leapfrog
-// whose velocities sit at half steps, and starting them there puts the circle's centre in the
-// right place (an offset of f dt / 2 of the radius otherwise). For a linear drag the scheme's
-// steady state is the exact one. The engines get M_e (q_n+1 - q_n) / dt as constant loads,
-// M_e the mass they move (m, or m_I when added mass enters contacts).
+// where C q = m_I f~ (k x v, 0) and h = dt (half of it on a free body's first step, below).
+// Coriolis is trapezoidal (Cayley) with f~ = (2/h) tan(f' dt / 2), f' = f m / m_I, which
+// turns the velocity by exactly f' dt per step: no drift of the speed and no phase error, so
+// the inertial circle closes (the requirement is 1e-4 of the radius after 10 periods at
+// dt = 60 s).
+//
+// The engines move positions by symplectic Euler, x_n+1 = x_n + dt v_n+1: a leapfrog whose
+// velocities sit at half steps, v_n ~ v(t_n - dt/2). The step is second order when its force
+// is taken at t_n, between the two velocities it joins, and when the velocities start at
+// dt/2: the first step turns by f' dt / 2 (half the angle), and a free body (below) is given
+// half a step of force (h = dt/2; otherwise the drift is off by about its velocity change
+// over half a step, times its drag time: first order in dt).
+//
+// Where the force is taken, q^, and the weight s of D:
+// - a free body (no contact in the last step): q^ = q_n + (dt/2) a_n-1, its velocity at t_n
+//   extrapolated from the acceleration the forcing gave it in the last step (second order:
+//   a_n-1 = a(t_n) + O(dt)), and s = 0 while h |D| / M < 0.5. For a floe in a current with
+//   Coriolis and linearised drag the position error then falls four-fold when dt halves,
+//   against two-fold with q^ = q_n. One evaluation of the terms, without D.
+// - a body that touched another in the last step: q^ = q_n, s = 0 while h |D| / M < 0.5.
+//   Explicit, and at q_n, because the load handed on is the force of a body that moves
+//   freely: a body held still by contacts would see its drag under-reported by
+//   1 / (1 + s h |D| / M) (0.2 % for a 10 m floe at dt = 0.05 s with s = 1), or taken at a
+//   velocity it does not reach, and the ice loads on held bodies are what users read. Its
+//   first step is a whole one.
+// - either, where h |D| / M >= 0.5 (a small floe at a long step): s = 1, linearly implicit
+//   (Rosenbrock-Euler: stable at any dt, first order), at q_n (an extrapolation by a stiff
+//   acceleration would not be stable); such a body relaxes to the flow within a few steps.
+// For a linear drag the steady state is the exact one in every case. The engines get
+// M_e (q_n+1 - q_n) / dt as constant loads, M_e the mass they move (m, or m_I when added mass
+// enters contacts); contacts then act by their impulse laws on top, unchanged.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -62,12 +80,12 @@ std::array<double, 3> Forcing::environment_force(std::size_t i) const {
   return q;
 }
 
-bool Forcing::stiff(const std::array<double, 9>& d, double mass, double inertia) const {
-  // dt times the largest rate |D| / M (row sums): explicit Euler is stable below 2, and
-  // accurate well below 1.
+double Forcing::drag_rate(const std::array<double, 9>& d, double mass, double inertia) {
+  // Row sums bound the eigenvalues (Gershgorin): h times this rate below 2 keeps explicit
+  // Euler stable, well below 1 accurate.
   const double linear = std::max(std::abs(d[0]) + std::abs(d[1]), std::abs(d[3]) + std::abs(d[4])) / mass;
   const double angular = std::abs(d[8]) / inertia;
-  return dt_ * std::max(linear, angular) > kExplicitLimit;
+  return std::max(linear, angular);
 }
 
 Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(scene.run.dt) {
@@ -110,6 +128,7 @@ Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(
   if (moving_only_) dirty_.reserve(n);
   rotated_angle_.assign(n, std::numeric_limits<double>::quiet_NaN());  // NaN: none computed yet
   cached_rate_.assign(n, 0.0);
+  ahead_.assign(n, {});
   cached_tan_.assign(n, 0.0);
   cached_half_tan_.assign(n, 0.0);
   // What the per-step loop reads, packed per body: the scene's bodies are large records.
@@ -157,8 +176,10 @@ std::vector<std::string_view> Forcing::names() const {
   return out;
 }
 
-const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<const Rot> rotations) {
+const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<const Rot> rotations,
+                               std::span<const std::uint8_t> touching) {
   if (empty()) return nullptr;
+  touching_ = touching.size() == hot_.size() ? touching : std::span<const std::uint8_t>{};
   loads_.prescribed.clear();
   for (const std::size_t i : prescribed_) {
     // Mid-step velocity: dt times it is the path's exact displacement (piecewise linear).
@@ -188,6 +209,25 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     }
     at.velocity = moved_velocity_;
     at.angular_velocity = moved_angular_velocity_;
+  }
+  // A free body feels the terms at its mid-step velocity q_n + (dt/2) a_n-1 (the comment at
+  // the top; a_n-1 is zero for a touching or stiff body, and before the first step).
+  if (any_ahead_) {
+    if (prescribed_.empty()) {
+      moved_velocity_.assign(state.velocity.begin(), state.velocity.end());
+      moved_angular_velocity_.assign(state.angular_velocity.begin(), state.angular_velocity.end());
+      at.velocity = moved_velocity_;
+      at.angular_velocity = moved_angular_velocity_;
+    }
+    const double half = 0.5 * dt_;
+    thread_pool().for_blocks(hot_.size(), 8192, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::array<double, 3>& a = ahead_[i];
+        if (!free_body(i) || (a[0] == 0.0 && a[1] == 0.0 && a[2] == 0.0)) continue;
+        moved_velocity_[i] += half * Vec2{a[0], a[1]};
+        moved_angular_velocity_[i] += half * a[2];
+      }
+    });
   }
 
   // Per body: its rotation, the engine's where it has them (the same Rot::from_angle of the
@@ -232,7 +272,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     }
   }
   // Which bodies need D: where the terms' bound on dt |D| / M stays below the explicit limit,
-  // stiff() would find the body explicit whatever D is, so D is not computed (the terms then
+  // load_body would find the body explicit whatever D is, so D is not computed (the terms then
   // skip its nine products per quadrature point). The margin covers rounding in the sums.
   if (!sparse) std::fill(sums_.rate_bound.begin(), sums_.rate_bound.end(), std::array<double, 2>{});
   bool bounded = true;
@@ -291,11 +331,15 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     dirty_.assign(moving.begin(), moving.end());
     have_dirty_ = true;
   }
+  any_ahead_ = std::any_of(ahead_.begin(), ahead_.end(), [](const std::array<double, 3>& a) {
+    return a[0] != 0.0 || a[1] != 0.0 || a[2] != 0.0;
+  });
   return &loads_;
 }
 
 void Forcing::load_body(std::size_t i, const BodyStates& state, bool first_step) {
   const BodyHot& h = hot_[i];
+  ahead_[i] = {};
   if (!h.moves) {
     loads_.force[i] = {};
     loads_.torque[i] = 0.0;
@@ -305,7 +349,10 @@ void Forcing::load_body(std::size_t i, const BodyStates& state, bool first_step)
   const double ii = h.inertia_with_added;
   const std::array<double, 3>& q = sums_.q[i];
   std::array<double, 3> dv;
-  const bool implicit = sums_.any_jacobian && stiff(sums_.dq[i], mi, ii);
+  // The step's length and whether it is implicit (the comment at the top).
+  const bool free = free_body(i);
+  const double step = free && first_step ? 0.5 * dt_ : dt_;
+  const bool implicit = sums_.any_jacobian && step * drag_rate(sums_.dq[i], mi, ii) > kExplicitLimit;
   // A body no term pushed (Q = +0), explicit, that Coriolis cannot turn (at rest, or no
   // rotation) gets no load: the paths below give +0 to the bit (rhs = +0 whatever the sign
   // of a zero velocity), here without their divisions (the rotation rate's too, when the
@@ -323,37 +370,51 @@ void Forcing::load_body(std::size_t i, const BodyStates& state, bool first_step)
     return;
   }
   if (!implicit && f == 0.0) {
-    dv = {dt_ * q[0] / mi, dt_ * q[1] / mi, dt_ * q[2] / ii};
+    dv = {step * q[0] / mi, step * q[1] / mi, step * q[2] / ii};
   } else {
-    // f~ = (2 / dt) tan(angle / 2), so that the Cayley turn is exactly the angle; tan is
+    // f~ = (2 / h) tan(angle / 2), so that the Cayley turn is exactly the angle; tan is
     // cached per body (the rate rarely changes).
     if (f != cached_rate_[i]) {
       cached_rate_[i] = f;
       cached_tan_[i] = std::tan(0.5 * f * dt_);
       cached_half_tan_[i] = std::tan(0.25 * f * dt_);
     }
-    const double ft = (2.0 / dt_) * (first_step ? cached_half_tan_[i] : cached_tan_[i]);
+    const double ft = (2.0 / step) * (first_step ? cached_half_tan_[i] : cached_tan_[i]);
     const double cv = mi * ft;  // C = cv [[0, -1], [1, 0]] on v
     const Vec2 v = state.velocity[i];
     const std::array<double, 3> rhs{q[0] + cv * v.y, q[1] - cv * v.x, q[2]};
     if (!implicit) {
-      // [[M, -c], [c, M]] dv = rhs with M = m_I / dt, c = cv / 2: closed form.
-      const double m = mi / dt_, c = 0.5 * cv;
+      // [[M, -c], [c, M]] dv = rhs with M = m_I / h, c = cv / 2: closed form.
+      const double m = mi / step, c = 0.5 * cv;
       const double det = m * m + c * c;
-      dv = {(m * rhs[0] + c * rhs[1]) / det, (m * rhs[1] - c * rhs[0]) / det, dt_ * q[2] / ii};
+      dv = {(m * rhs[0] + c * rhs[1]) / det, (m * rhs[1] - c * rhs[0]) / det, step * q[2] / ii};
     } else {
       std::array<double, 9> a = sums_.dq[i];
       for (double& x : a) x = -x;
-      a[0] += mi / dt_;
-      a[4] += mi / dt_;
-      a[8] += ii / dt_;
+      a[0] += mi / step;
+      a[4] += mi / step;
+      a[8] += ii / step;
       a[1] += -0.5 * cv;
       a[3] += 0.5 * cv;
       dv = solve3(a, rhs);
     }
   }
+  if (free && !implicit) ahead_[i] = {dv[0] / step, dv[1] / step, dv[2] / step};
   loads_.force[i] = {h.engine_mass * dv[0] / dt_, h.engine_mass * dv[1] / dt_};
   loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
+}
+
+void Forcing::save(StateWriter& out) const {
+  out.tag("forcing");
+  out.vector(ahead_);
+}
+
+void Forcing::restore(StateReader& in) {
+  in.tag("forcing");
+  in.vector(ahead_, hot_.size(), "forcing: accelerations");
+  any_ahead_ = std::any_of(ahead_.begin(), ahead_.end(), [](const std::array<double, 3>& a) {
+    return a[0] != 0.0 || a[1] != 0.0 || a[2] != 0.0;
+  });
 }
 
 }  // namespace floedem

@@ -1,19 +1,84 @@
 #include "run/stepper.hpp"
 
+#include <algorithm>
+
 #include "floedem/engine/registry.hpp"
 
 namespace floedem {
 
+namespace {
+
+// The bodies taken as touching on the first step, before any engine has found a contact: each
+// body whose bounding box, grown by its reach in one step (|v| dt) and a centimetre, overlaps
+// another's. A superset of the touching bodies (boxes, not polygons), so that a body that
+// starts in contact gets its whole first step of force, as every step after (forcing.cpp).
+// Boxes sorted along the axis over which the scene spreads more, then swept: each box meets
+// those that start before it ends.
+std::vector<std::uint8_t> touching_at_start(const Scene& scene) {
+  const std::size_t n = scene.bodies.size();
+  struct Box {
+    Vec2 lo, hi;
+  };
+  std::vector<Box> box(n);
+  Vec2 lo_all{1e300, 1e300}, hi_all{-1e300, -1e300};
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodySpec& b = scene.bodies[i];
+    Box& x = box[i];
+    x.lo = x.hi = b.polygon.empty() ? b.centroid : b.polygon.front();
+    for (const Vec2 p : b.polygon) {
+      x.lo = {std::min(x.lo.x, p.x), std::min(x.lo.y, p.y)};
+      x.hi = {std::max(x.hi.x, p.x), std::max(x.hi.y, p.y)};
+    }
+    const double grow = length(b.velocity) * scene.run.dt + 0.01;
+    x.lo -= Vec2{grow, grow};
+    x.hi += Vec2{grow, grow};
+    lo_all = {std::min(lo_all.x, x.lo.x), std::min(lo_all.y, x.lo.y)};
+    hi_all = {std::max(hi_all.x, x.hi.x), std::max(hi_all.y, x.hi.y)};
+  }
+  const bool along_x = hi_all.x - lo_all.x >= hi_all.y - lo_all.y;
+  auto lo = [&](std::size_t i) { return along_x ? box[i].lo.x : box[i].lo.y; };
+  auto hi = [&](std::size_t i) { return along_x ? box[i].hi.x : box[i].hi.y; };
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return lo(a) < lo(b); });
+  std::vector<std::uint8_t> touching(n, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t a = order[k];
+    for (std::size_t j = k + 1; j < n && lo(order[j]) <= hi(a); ++j) {
+      const std::size_t b = order[j];
+      if (box[a].lo.x <= box[b].hi.x && box[b].lo.x <= box[a].hi.x && box[a].lo.y <= box[b].hi.y &&
+          box[b].lo.y <= box[a].hi.y)
+        touching[a] = touching[b] = 1;
+    }
+  }
+  return touching;
+}
+
+}  // namespace
+
 Stepper::Stepper(const Scene& scene, const std::string& engine)
-    : scene_(scene), dt_(scene.run.dt), engine_(make_engine(engine, scene)), forcing_(scene), tow_(scene) {}
+    : scene_(scene), dt_(scene.run.dt), engine_(make_engine(engine, scene)), forcing_(scene), tow_(scene) {
+  if (!forcing_.empty()) touching_ = touching_at_start(scene);
+}
 
 void Stepper::step() {
   const double start = time();
   if (tow_.active()) stages_.time(kTowing, [&] { tow_.before_step(engine_->state(), start); });
-  stages_.time(kForcing, [&] { loads_ = forcing_.evaluate(engine_->state(), start, engine_->rotations()); });
+  stages_.time(kForcing, [&] {
+    loads_ = forcing_.evaluate(engine_->state(), start, engine_->rotations(), touching_);
+  });
   engine_->step(loads_);
   if (tow_.active())
     stages_.time(kTowing, [&] { tow_.after_step(engine_->contacts(), forcing_.environment_force(scene_.tow.body)); });
+  // Which bodies the next step's forcing takes as touching (a contact with an impulse in this
+  // step, on any engine: Engine::contacts): their step stays first order, the others' second.
+  if (!forcing_.empty()) {
+    touching_.assign(engine_->state().position.size(), 0);
+    for (const ContactRecord& c : engine_->contacts()) {
+      touching_[static_cast<std::size_t>(c.body_a)] = 1;
+      touching_[static_cast<std::size_t>(c.body_b)] = 1;
+    }
+  }
   ++steps_;
 }
 
@@ -40,6 +105,9 @@ bool Stepper::save(StateWriter& out) const {
     return false;
   }
   tow_.save(out);  // its tag also tells, on reading, where the engine's state must have ended
+  out.tag("touching");
+  out.vector(touching_);
+  forcing_.save(out);
   return true;
 }
 
@@ -48,6 +116,9 @@ void Stepper::restore(StateReader& in) {
   in.value(steps_);
   engine_->restore_state(in);
   tow_.restore(in);
+  in.tag("touching");
+  in.vector(touching_);
+  forcing_.restore(in);
 }
 
 }  // namespace floedem

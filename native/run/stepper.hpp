@@ -42,8 +42,9 @@ class Stepper {
   /// Each stage's summed wall time since time_stages(true), in the order a step makes them.
   std::vector<StageTime> stage_times() const;
 
-  /// Checkpoint: the step count, the engine's state and the tow's (the forcing holds none
-  /// between steps). False, writing nothing, when the engine cannot save its state.
+  /// Checkpoint: the step count, the engine's state, the tow's, which bodies touched in the
+  /// last step and the forcing's memory of it. False, writing nothing, when the engine cannot
+  /// save its state.
   bool save(StateWriter& out) const;
   void restore(StateReader& in);
 
@@ -55,6 +56,7 @@ class Stepper {
   TowMonitor tow_;
   std::int64_t steps_ = 0;
   const Loads* loads_ = nullptr;
+  std::vector<std::uint8_t> touching_;  ///< per body: a contact in the last step (Forcing::evaluate)
   // The two stages of floedem/engine/step_stages.hpp that the stepper makes around the engine's own.
   enum Stage : std::size_t { kForcing, kTowing, kStages };
   StageClock<kStages> stages_{{kStepStages[step_stage("forcing")].name, kStepStages[step_stage("towing")].name}};

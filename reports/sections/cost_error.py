@@ -154,7 +154,7 @@ def write(ctx):
         else:
             err = abs(towing_mean(r.out, s_stat)[0] - ref_mean) / abs(ref_mean)
         label = f"{r.meta['iterations']}it/{r.meta['dt']:.3g}s" if r.meta["iterations"] else f"{r.meta['dt']:g}s"
-        points.setdefault(case, {}).setdefault(r.engine, []).append((err, cost, label))
+        points.setdefault(case, {}).setdefault(r.engine, []).append((err, cost, label, r.meta["dt"]))
 
     titles = {"impact": ("impact: velocity error / approach speed", "head-on floes, e = 0.1"),
               "drift": ("free drift: largest position error over 24 h (m)", "Coriolis + linear drag"),
@@ -220,6 +220,19 @@ def write(ctx):
         not_below = [f"{c} vs {e}" for c, e, ok in verdicts if not ok]
         md += [f"Native's curve below the reference's (every reference point beaten): "
                f"{', '.join(below) if below else 'none'}; not: {', '.join(not_below) if not_below else 'none'}.", ""]
+    order = drift_order(points.get("drift", {}).get("native", []))
+    if order:
+        md += ["Native's free drift converges at order " + ", ".join(
+               f"{o:.2f} (dt {a:g} to {b:g} s)" for a, b, o in order) + ": log(e(dt_1) / e(dt_2)) / log(dt_1 / dt_2) "
+               "between neighbouring steps, 2 for a second-order scheme (the leapfrog with the forcing taken at "
+               "mid-step, `docs/model.md` 2).", ""]
     if refused:
         md += ["Points an engine refused: " + "; ".join(refused) + ".", ""]
     return md, []
+
+
+def drift_order(pts):
+    """Observed order between neighbouring steps of the drift points (err, cost, label, dt):
+    [(dt_coarse, dt_fine, order)], errors at the resolution left out (rounding, not the scheme)."""
+    pts = sorted((p for p in pts if p[0] > RESOLUTION["drift"]), key=lambda p: -p[3])
+    return [(a[3], b[3], math.log(a[0] / b[0]) / math.log(a[3] / b[3])) for a, b in zip(pts, pts[1:])]

@@ -198,8 +198,9 @@ TEST_CASE("forcing: in still water with Coriolis the moving bodies alone give ev
           "[forcing]") {
   // After its first step a Forcing whose terms are all idle at rest (still-water drag,
   // Coriolis) zeroes what its last step wrote and works on the moving bodies alone. Its loads
-  // must be those of a fresh Forcing, which works on every body, step after step, while
-  // floes start, stop (to +0 and to -0), spin in place and move again, and a towed body ramps.
+  // must be those of a fresh Forcing, which works on every body, given the same memory of the
+  // last step (the free bodies' accelerations: forcing.cpp), step after step, while floes
+  // start, stop (to +0 and to -0), spin in place and move again, and a towed body ramps.
   std::string t = "[run]\nduration = 10.0\ndt = 0.5\n[environment]\nlatitude = 75.0\n";
   for (int i = 0; i < 6; ++i) t += test::body_toml({"f" + std::to_string(i), test::box({40.0 * i, 0.0}, 10.0, 7.0), {}, 0.0});
   t += "[[body]]\nname = \"berg\"\nkind = \"iceberg\"\npolygon = [[300, -20], [340, -20], [340, 20], [300, 20]]\n"
@@ -227,6 +228,10 @@ TEST_CASE("forcing: in still water with Coriolis the moving bodies alone give ev
     }
     const double time = 0.5 * static_cast<double>(k);
     Forcing fresh(s);
+    StateWriter memory;
+    kept.save(memory);
+    StateReader read(memory.bytes().data(), memory.size());
+    fresh.restore(read);
     const Loads* a = kept.evaluate(st, time);
     const Loads* b = fresh.evaluate(st, time);
     for (std::size_t i = 0; i < s.bodies.size(); ++i) {

@@ -1,9 +1,11 @@
 // Resting contact: a steady push against a wall, and a pressed row of floes.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <random>
 
 #include "floedem/run/simulation.hpp"
+#include "run/stepper.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -21,11 +23,11 @@ TEST_CASE("a floe pushed against a fixed wall: force equals the push, no jitter"
                            test::body_toml({"floe", test::box({5, 5}, 10, 10), {}, 0.0, false, {kPush, 0.0}}) +
                            test::body_toml({"wall", test::box({11, 5}, 2, 40), {}, 0.0, true});
   const Scene s = test::scene_from(text);
-  auto e = test::native(s);
-  Forcing forcing(s);
+  Stepper run(s, "native");
+  const Engine* e = &run.engine();
   double worst_force = 0.0, worst_speed = 0.0, worst_spin = 0.0;
   for (int k = 0; k < 2000; ++k) {
-    e->step(forcing.evaluate(e->state(), k * dt));
+    run.step();
     // The wall (body 1) is b: its contact force is +x; the floe's is -push.
     worst_force = std::max(worst_force, std::abs(-test::contact_force_x(*e, 0, dt) - kPush) / kPush);
     worst_speed = std::max(worst_speed, length(e->state().velocity[0]));
@@ -47,12 +49,12 @@ TEST_CASE("a floe accelerated into a wall bounces, then comes to rest carrying t
                            test::body_toml({"floe", test::box({4.95, 5}, 10, 10), {}, 0.0, false, {kPush, 0.0}}) +
                            test::body_toml({"wall", test::box({11, 5}, 2, 40), {}, 0.0, true});
   const Scene s = test::scene_from(text);
-  auto e = test::native(s);
-  Forcing forcing(s);
+  Stepper run(s, "native");
+  const Engine* e = &run.engine();
   int collisions = 0;
   double max_overlap = 0.0;
   for (int k = 0; k < 6000; ++k) {
-    e->step(forcing.evaluate(e->state(), k * dt));
+    run.step();
     for (const auto& c : e->contacts()) collisions += c.kind == ContactKind::collision;
     max_overlap = std::max(max_overlap, e->state().position[0].x + 5.0 - 10.0);
     if (k >= 5000) {
@@ -98,18 +100,23 @@ RowResult press_row(double mu, const std::string& native) {
   text += test::body_toml({"bank-1", {{-10.0, 10.6}, {x, 10.6}, {x, 14.0}, {-10.0, 14.0}}, {}, 0.0, true});
   text += test::body_toml({"bank-2", {{-10.0, -4.0}, {x, -4.0}, {x, -0.6}, {-10.0, -0.6}}, {}, 0.0, true});
   const Scene s = test::scene_from(text);
-  auto e = test::native(s);
-  Forcing forcing(s);
+  Stepper run(s, "native");
+  const Engine* e = &run.engine();
   RowResult r;
   double energy = kinetic_energy(s, e->state());
   r.largest_energy = energy;
+  std::vector<Vec2> before(static_cast<std::size_t>(n));
   for (int k = 0; k < 10000; ++k) {
-    // Work of the constant forces over this step, exactly as symplectic Euler applies it:
+    std::copy_n(e->state().velocity.begin(), n, before.begin());
+    run.step();
+    // Work of the step's loads (the constant forces; half of them on the first step, the
+    // leapfrog's start: forcing.cpp), exactly as symplectic Euler applies it:
     // 1/2 m (v*^2 - v^2) with v* = v + dt F / m.
     double work = 0.0;
-    for (int i = 0; i < n; ++i)
-      work += dot(force[i], e->state().velocity[i]) * dt + length_squared(force[i]) * dt * dt / (2.0 * s.bodies[i].mass);
-    e->step(forcing.evaluate(e->state(), k * dt));
+    for (int i = 0; i < n; ++i) {
+      const Vec2 f = run.last_loads()->force[static_cast<std::size_t>(i)];
+      work += dot(f, before[static_cast<std::size_t>(i)]) * dt + length_squared(f) * dt * dt / (2.0 * s.bodies[i].mass);
+    }
     const double next = kinetic_energy(s, e->state());
     r.worst_gain = std::max(r.worst_gain, next - (energy + work));
     energy = next;
