@@ -88,6 +88,10 @@ class NativeEngine final : public Engine {
   void solve_contacts();
   struct IslandWork;
   int solve_island(std::size_t island, bool checked, IslandWork& work, SweepPipeline* pipeline);
+  // Whether island i is swept colour by colour (NativeSettings::coloured_from; islands_ built).
+  bool coloured(std::size_t i) const {
+    return static_cast<std::int64_t>(islands_.manifolds(i).size()) >= settings_.coloured_from;
+  }
   void solve_islands_directly(double energy_before);
   bool contacts_gain_energy(double energy_before) const;
   double contact_kinetic_energy() const;
@@ -237,7 +241,7 @@ EngineInfo NativeEngine::info() const {
       {"velocity_iterations", std::to_string(settings_.velocity_iterations)},
       {"extra_iterations", std::to_string(settings_.extra_iterations)},
       {"accelerate", settings_.accelerate ? "true" : "false"},
-      {"coloured_sweeps", settings_.coloured_sweeps ? "true" : "false"},
+      {"coloured_from", std::to_string(settings_.coloured_from)},
       {"tolerance", setting_text(settings_.tolerance)},
       {"warm_start", settings_.warm_start ? "true" : "false"},
       {"position_iterations", std::to_string(settings_.position_iterations)},
@@ -664,18 +668,22 @@ void NativeEngine::solve_contacts() {
   const std::size_t n = islands_.size();
   const std::size_t blocks = std::max<std::size_t>(1, (n + kIslandGrain - 1) / kIslandGrain);
   if (island_work_.size() < blocks) island_work_.resize(blocks + blocks / 2);
-  const std::size_t colour_bodies = settings_.coloured_sweeps ? bodies_.inv_mass.size() : 0;
+  bool any_coloured = false;
+  for (std::size_t i = 0; i < n && !any_coloured; ++i) any_coloured = coloured(i);
+  const std::size_t colour_bodies = any_coloured ? bodies_.inv_mass.size() : 0;
   sweep_work_.reserve(manifolds_.size(), settings_.accelerate, colour_bodies);
-  if (settings_.coloured_sweeps) {
+  if (any_coloured) {
     // The islands coloured first, so that each island's bundles get a slice of exactly their
     // number (a bound per island, bundles_for, came to a bundle a manifold for the many small
     // islands: a 768-byte bundle each, and a total that grew as the pack broke up and closed again).
     resize_with_headroom(island_bundles_, n + 1);
     island_bundles_[0] = 0;
     for (std::size_t i = 0; i < n; ++i) {
+      island_bundles_[i + 1] = island_bundles_[i];
+      if (!coloured(i)) continue;
       const SweepSpace space = sweep_work_.slice(islands_.manifold_offset(i), islands_.manifolds(i).size());
-      island_bundles_[i + 1] = island_bundles_[i] + colour_manifolds(manifolds_, islands_.manifolds(i), bodies_,
-                                                                     space.overflow, space.body_colours);
+      island_bundles_[i + 1] += colour_manifolds(manifolds_, islands_.manifolds(i), bodies_, space.overflow,
+                                                 space.body_colours);
     }
     sweep_work_.reserve(manifolds_.size(), settings_.accelerate, colour_bodies, island_bundles_[n]);
   }
@@ -689,9 +697,10 @@ void NativeEngine::solve_contacts() {
   // pipelined (sweep_pipeline.hpp), or its colours swept on every thread (coloured sweeps, NNCG
   // or not): on two threads, the rest of the islands and it would otherwise wait for the one
   // thread that has it.
-  const bool pipelined = (!settings_.accelerate || settings_.coloured_sweeps) && thread_pool().size() > 1;
+  const bool pipelined = thread_pool().size() > 1;
   auto large = [&](std::size_t i) {
-    return pipelined && SweepPipeline::parts_for(2 * islands_.manifolds(i).size()) > 1;
+    return pipelined && (!settings_.accelerate || coloured(i)) &&
+           SweepPipeline::parts_for(2 * islands_.manifolds(i).size()) > 1;
   };
   thread_pool().for_blocks(n, kIslandGrain, [&](std::size_t begin, std::size_t end) {
     IslandWork& w = island_work_[begin / kIslandGrain];
@@ -738,7 +747,8 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
     }
   }
   SweepSpace space = sweep_work_.slice(islands_.manifold_offset(island), manifolds.size());
-  if (settings_.coloured_sweeps) {
+  const bool colour = coloured(island);
+  if (colour) {
     space = sweep_work_.slice(islands_.manifold_offset(island), manifolds.size(), island_bundles_[island],
                               island_bundles_[island + 1] - island_bundles_[island]);
     space.colours_given = true;  // by solve_contacts
@@ -747,7 +757,7 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
                                 {.warm_start = settings_.warm_start,
                                  .accelerate = settings_.accelerate,
                                  .pipeline = pipeline,
-                                 .colour = settings_.coloured_sweeps});
+                                 .colour = colour});
   if (!checked) return sweeps;
   double pushed = 0.0;  // the work of towed bodies on this island's floes (contacts_gain_energy)
   if (has_prescribed_)
@@ -763,7 +773,7 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
   }
   space.colours_given = false;  // the first solve kept its list of rows beyond the colours there: colour again
   sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,  // plain sweeps: no energy made
-                             {.pipeline = pipeline, .colour = settings_.coloured_sweeps});
+                             {.pipeline = pipeline, .colour = colour});
   ++work.cold_restarts;
   return sweeps;
 }

@@ -1,4 +1,6 @@
 #pragma once
+#include <cstdint>
+
 #include "floedem/scene/scene.hpp"
 
 namespace floedem {
@@ -10,7 +12,11 @@ struct NativeSettings {
   double tolerance = 1e-10;          ///< stop sweeping when max |dP| <= tolerance * max |P|
   bool warm_start = true;            ///< start from last step's resting impulses
   bool accelerate = true;            ///< conjugate-gradient step after each sweep (NNCG)
-  bool coloured_sweeps = false;      ///< sweep the contacts colour by colour (graph colouring), not in pair order
+  /// Islands of at least this many manifolds are swept colour by colour (graph colouring, four
+  /// at a time, their colours on every thread), smaller ones in pair order: measured on the
+  /// report's scenes (docs/architecture.md). `coloured_sweeps = true` in a scene sets it to 0
+  /// (every island), `false` to never.
+  std::int64_t coloured_from = 16384;
   int position_iterations = 4;       ///< position-projection sweeps per step (0: none)
   double position_correction = 0.2;  ///< fraction of the overlap removed per sweep
   double allowed_penetration = 1e-3; ///< m, overlap left alone (keeps contacts persistent)
