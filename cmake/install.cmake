@@ -31,7 +31,7 @@ install(FILES ${PROJECT_BINARY_DIR}/floedemConfig.cmake ${PROJECT_BINARY_DIR}/fl
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/reports/ DESTINATION ${FLOEDEM_DATA_DIR}/reports
   FILES_MATCHING PATTERN "*.py" PATTERN "observations_verdicts_*.json" PATTERN "latest" EXCLUDE PATTERN "bench" EXCLUDE
-  PATTERN "threads-*" EXCLUDE PATTERN "tests" EXCLUDE PATTERN "__pycache__" EXCLUDE)
+  PATTERN "threads-*" EXCLUDE PATTERN "anchors" EXCLUDE PATTERN "tests" EXCLUDE PATTERN "__pycache__" EXCLUDE)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenarios/ DESTINATION ${FLOEDEM_DATA_DIR}/scenarios)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/profiles/ DESTINATION ${FLOEDEM_DATA_DIR}/profiles)
 # The Python package: beside the command (which runs `python3 -m floedem` from there), with its

@@ -1,32 +1,31 @@
 """Threads: native's step on 1 thread up to every core of the machine the report runs
 on, on the field benchmark packed on its wall (scenarios/bench/field_wall_*.toml), by `floedem
 bench --stages` with FLOEDEM_THREADS set; and the check that the thread count changes nothing:
-the same field run on 1 thread and on every core, in colour order (the benchmark's
-`coloured_sweeps`) and in pair order with native's defaults (NNCG, pipelined sweeps), must
-write the same HDF5 file to the byte (no timestamps are stored; tests/run/test_determinism.cpp
-checks 1 against 4 threads on every CI run, this checks every core of the report's machine).
+the same field run on 1 thread and on every core, in colour order (10 plain sweeps, the
+speed section's equal iterations) and in pair order (native's defaults otherwise: NNCG, extra
+sweeps), must write the same HDF5 file to the byte (no timestamps are stored;
+tests/run/test_determinism.cpp checks 1 against 4 threads on every CI run, this checks every
+core of the report's machine).
 
-On 2 cores the scaling runs are the 4k field; where there are 8 cores or more the 16k field is
-timed too. The 16-core figures of the committed report come from `floedem report --only threads`
+The scaling runs time native's defaults (what a user gets) on the 4k and 16k fields. The 16-core figures of the committed report come from `floedem report --only threads`
 run on a 16-core machine (reports/threads-16/README.md says which and how)."""
 import os
 
 from report_runner import Run
-from sections.speed import STAGE_LABELS, read_row, stages, write_rows
+from sections.speed import STAGE_LABELS, equal, read_row, stages, write_rows
 
-# The benchmark's own settings (colour order, 10 plain sweeps), and native's defaults (pair order,
-# 50 sweeps followed by NNCG steps, up to 450 more where a point still closes too fast).
-IDENTICAL_ORDERS = {"coloured": [], "pairs": ["engine.native.coloured_sweeps=false", "engine.native.accelerate=true",
-                                              "engine.native.velocity_iterations=50",
-                                              "engine.native.extra_iterations=450"]}
+# Colour order with 10 plain sweeps (the speed section's equal iterations), and pair order with
+# native's defaults otherwise (50 sweeps followed by NNCG steps, up to 450 more where a point
+# still closes too fast).
+IDENTICAL_ORDERS = {"coloured": equal("native"), "pairs": ["engine.native.coloured_sweeps=false"]}
 
 
 def config(quick, cores):
     if quick:   # a smoke run of the machinery: the field is not packed yet at 40 s
         return dict(scaling=[("1k", 40.0, 20.0)], identical=("1k", 20.0))
     # Packed by about 100 s (99 % of floes in contact); the 16k field is timed over a short
-    # window after that (as in the speed section), and only where enough cores make it quick.
-    scaling = [("4k", 150.0, 50.0)] + ([("16k", 110.0, 10.0)] if cores >= 8 else [])
+    # window after that (as in the speed section).
+    scaling = [("4k", 150.0, 50.0), ("16k", 110.0, 10.0)]
     return dict(scaling=scaling, identical=("4k", 120.0))
 
 
@@ -73,12 +72,13 @@ def write(ctx):
     any_row = next(iter(rows.values()))[0][1]
     md = ["## Threads", "",
           f"Native on 1 to {cores} threads (FLOEDEM_THREADS) on {any_row['cpu']} ({any_row['host']}), `floedem bench "
-          "--stages`, one run at a time (all rows: `threads.csv`): median ms per step over the timed window of the field packed on its wall. "
+          "--stages` with native's defaults, one run at a time (all rows: `threads.csv`): median ms per step over "
+          "the timed window of the field packed on its wall. "
           "The per-body and per-pair loops (drag, forcing, placing, narrow phase, integration) and the contact "
-          "solve's islands run on the pool, and the sweeps of an island too large for one thread (a field packed on "
-          "a wall is nearly one island) run on every thread: colour by colour with the benchmark's "
-          "`coloured_sweeps` (`native/solver/coloured_sweeps.cpp`), pipelined in pair order otherwise "
-          "(`native/solver/sweep_pipeline.cpp`). What stays on one thread bounds the speed-up: the position "
+          "solve's islands run on the pool, and the sweeps of an island large enough to be swept in colour order "
+          "(`engine.native.coloured_from` manifolds: the 16k field's, not the 4k field's) run on every thread, "
+          "colour by colour (`native/solver/coloured_sweeps.cpp`); an island swept in pair order with NNCG is one "
+          "thread's. What stays on one thread bounds the speed-up: the position "
           "projection, the island grouping, and the large island's colouring and warm start, while its packing into "
           "bundles runs on the other threads (the stages' table below).", ""]
     sizes = sorted(rows, key=lambda s: int(rows[s][0][1]["bodies"]))
@@ -127,8 +127,8 @@ def identical(ctx, cores):
                          f"({pair[1].out}, {pair[cores].out})")
     first = runs[0]
     md = [f"Does the thread count change the output? `{os.path.basename(first.scenario)}` run with "
-          f"{' '.join('--set ' + s for s in first.sets[:3])} on 1 and on {cores} threads, in colour order and in "
-          "pair order (native's defaults: NNCG, pipelined sweeps); the HDF5 files (every body's state each 100 "
+          f"{' '.join('--set ' + s for s in first.sets[:3])} on 1 and on {cores} threads, in colour order (10 "
+          "plain sweeps) and in pair order (native's defaults otherwise: NNCG); the HDF5 files (every body's state each 100 "
           "steps, every collision's impulses) compared byte for byte. Tolerance: none; the solver's order is fixed, "
           "so any difference is a bug.", "",
           "| order | files (runs/) | sizes | the same to the byte |", "|---|---|---|---|"] + lines + [""]
