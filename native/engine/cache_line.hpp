@@ -1,8 +1,7 @@
 #pragma once
 // The cache line of the x86-64 processors floedem is measured on (AMD Zen, Intel): the unit a
 // prefetch asks for (prefetch.hpp), the alignment of the lists whose records are whole lines
-// (line_vector.hpp) and of the coloured sweeps' bundles, and the room each thread's record
-// takes so that no two threads write one line (sweep_pipeline.hpp).
+// (line_vector.hpp) and of the coloured sweeps' bundles.
 #include <cstddef>
 
 namespace floedem {

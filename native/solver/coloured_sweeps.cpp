@@ -351,10 +351,6 @@ void pack_lane(SweepBundle& b, int lane, const Manifold& c, std::size_t i, const
   if (empty_second) empty_point(b.point[1], lane);
 }
 
-// The packing of a large solve on the pool's threads (an island of this many manifolds or more,
-// its colours swept on every thread): on one thread it was a serial part of the packed 16k
-// field's step that the threads could not shorten (perf).
-constexpr std::size_t kThreadedPacking = 4096;
 constexpr std::size_t kThreadedPackingMost = std::size_t{1} << 27;  // slots (4 a bundle) below kEmptiesSecond
 constexpr std::size_t kPackingBlock = 1024;            // manifolds a block of the threaded packing
 constexpr std::int32_t kEmptiesSecond = 1 << 30;       // in a slot: empty_second for pack_lane
@@ -446,7 +442,7 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
     return n;
   };
   // A large solve swept on the threads (and nothing beyond the colours) is packed on them too.
-  const bool on_threads = threads && count[kColours] == 0 && m.size() >= kThreadedPacking &&
+  const bool on_threads = threads && count[kColours] == 0 && m.size() >= kColouredOnThreads &&
                           m.size() < kThreadedPackingMost && thread_pool().size() > 1;
   if (on_threads) gather_on_threads(m, s, warm_start, space, first, place, empties_second);
   for (std::size_t i = 0; !on_threads && i < m.size(); ++i) {

@@ -32,6 +32,12 @@
 
 namespace floedem {
 
+/// A coloured solve of at least this many manifolds is worth the pool's threads: its packing
+/// into bundles runs on them (on one thread it was a serial part of the packed 16k field's step
+/// that the threads could not shorten: perf), and the native engine solves such an island
+/// alone on every thread rather than as one task among the islands.
+constexpr std::size_t kColouredOnThreads = 4096;
+
 /// The coloured solve of the manifolds `island` (indices into `manifolds`, in order; empty: all
 /// of them): solve_velocities with SweepOptions::colour. `space` needs bundles and slots for
 /// the manifolds, the scene's body_colours (all zero, and left so) and, with `accelerate`,

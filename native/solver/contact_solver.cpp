@@ -9,7 +9,6 @@
 #include "engine/prefetch.hpp"
 #include "solver/coloured_sweeps.hpp"
 #include "solver/headroom.hpp"
-#include "solver/sweep_pipeline.hpp"
 #include "solver/sweep_row.hpp"
 
 // Contact constraint, per point, between bodies a and b (normal n from a to b, tangent t = k x n):
@@ -157,7 +156,7 @@ void scatter_rows(const Rows& manifolds, std::span<const SweepRow> rows) {
 }
 
 int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limits, SweepSpace work,
-               bool accelerate, SweepPipeline* pipeline) {
+               bool accelerate) {
   if (accelerate) {
     work.change = work.change.first(2 * rows.size());
     work.direction = work.direction.first(2 * rows.size());
@@ -175,13 +174,6 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
     max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
     return true;
   };
-  if (!accelerate && pipeline != nullptr && limits.iterations > 1 && SweepPipeline::parts_for(rows.size()) > 1) {
-    // The ordinary sweeps on several threads; then, as the loop below after its sweep
-    // `iterations`, the look at what is left closing, and any extra sweeps here.
-    const SweepPipeline::Result made = pipeline->run(rows, s, limits.iterations, limits.tolerance);
-    sweep = made.sweeps;
-    if (made.converged || limits.extra_iterations <= 0 || !still_closing()) return sweep;
-  }
   while (sweep < max_iterations) {
     ++sweep;
     double largest_change = 0.0;
@@ -239,7 +231,7 @@ int solve_rows(const Rows& manifolds, BodyArrays& s, const SweepLimits& limits, 
   if (space.rows.size() < 2 * manifolds.size() || (options.accelerate && space.change.size() < 4 * manifolds.size()))
     throw std::logic_error("solve_velocities: the sweep space holds fewer manifolds than the solve");
   const std::span<SweepRow> rows = space.rows.first(gather_rows(manifolds, s, options.warm_start, space.rows));
-  const int sweeps = run_sweeps(rows, s, limits, space, options.accelerate, options.pipeline);
+  const int sweeps = run_sweeps(rows, s, limits, space, options.accelerate);
   scatter_rows(manifolds, rows);
   return sweeps;
 }
@@ -292,7 +284,7 @@ SweepSpace SweepWork::slice(std::size_t first, std::size_t count, std::size_t bu
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepSpace space,
                      SweepOptions options) {
   if (options.colour)
-    return solve_coloured(manifolds, {}, s, limits, space, options.warm_start, options.accelerate, options.pipeline,
+    return solve_coloured(manifolds, {}, s, limits, space, options.warm_start, options.accelerate, options.threads,
                           options.given_order);
   return solve_rows(AllRows{manifolds}, s, limits, space, options);
 }
@@ -301,7 +293,7 @@ int solve_velocities(std::span<Manifold> manifolds, std::span<const std::int32_t
                      const SweepLimits& limits, SweepSpace space, SweepOptions options) {
   if (options.colour)
     return solve_coloured(manifolds, island, s, limits, space, options.warm_start, options.accelerate,
-                          options.pipeline, options.given_order);
+                          options.threads, options.given_order);
   return solve_rows(IslandRows{manifolds, island}, s, limits, space, options);
 }
 

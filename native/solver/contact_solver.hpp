@@ -138,8 +138,6 @@ struct SweepLimits {
   double closing_speed = 0.0;  ///< ... a point approaches faster than its target by more than this (m/s)
 };
 
-class SweepPipeline;
-
 /// Gauss-Seidel sweeps until the largest impulse change is below tolerance times the largest
 /// impulse, or the limits' sweeps are spent. With `warm_start`, each point's accumulated impulse
 /// is applied first (as apply_accumulated_impulses with +1, in the same order); with
@@ -149,14 +147,13 @@ class SweepPipeline;
 struct SweepOptions {
   bool warm_start = false;
   bool accelerate = false;
-  /// Plain sweeps (without `accelerate`) of enough rows on the pool's threads, the same to the
-  /// bit (sweep_pipeline.hpp). Not from inside a loop of the pool.
-  SweepPipeline* pipeline = nullptr;
   /// Sweep the manifolds colour by colour, four at a time (coloured_sweeps.hpp), instead of in
   /// the order given: another Gauss-Seidel order, so other impulses after a given number of
-  /// sweeps. Needs the space's coloured arrays. With `pipeline` (which it does not use), each
-  /// colour is swept on the pool's threads, with `accelerate` too: the same to the bit.
+  /// sweeps. Needs the space's coloured arrays.
   bool colour = false;
+  /// Coloured: each colour large enough swept on the pool's threads, the same to the bit. Not
+  /// from inside a loop of the pool. (The sweeps in pair order are one thread's.)
+  bool threads = false;
   /// Coloured, without `accelerate`: place each colour's manifolds in the order given, not
   /// those of two points first (coloured_sweeps.cpp: the same impulses to the bit; the tests
   /// compare the two).

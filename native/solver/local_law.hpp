@@ -1,7 +1,7 @@
 #pragma once
 // The local contact law: the exact solution of one contact point's 2x2 problem, Newton
 // restitution with Coulomb friction, written once for every sweep of the native solver. The
-// sweeps in pair order (sweep_row.hpp: serial and pipelined) call it on doubles; the coloured
+// sweeps in pair order (sweep_row.hpp) call it on doubles; the coloured
 // sweeps (coloured_sweeps.cpp) on four lanes at once. One body of arithmetic for both, so a
 // lane holds the scalar result to the bit and a change to the law is made in one place.
 //

@@ -21,7 +21,6 @@
 #include "solver/island_solve.hpp"
 #include "solver/narrow_phase.hpp"
 #include "solver/part_set.hpp"
-#include "solver/sweep_pipeline.hpp"
 #include "solver/native_settings.hpp"
 #include "parallel/thread_pool.hpp"
 
@@ -87,7 +86,7 @@ class NativeEngine final : public Engine {
                      SeparationHint* hint = nullptr) const;
   void solve_contacts();
   struct IslandWork;
-  int solve_island(std::size_t island, bool checked, IslandWork& work, SweepPipeline* pipeline);
+  int solve_island(std::size_t island, bool checked, IslandWork& work, bool threads);
   // Whether island i is swept colour by colour (NativeSettings::coloured_from; islands_ built).
   bool coloured(std::size_t i) const {
     return static_cast<std::int64_t>(islands_.manifolds(i).size()) >= settings_.coloured_from;
@@ -175,7 +174,6 @@ class NativeEngine final : public Engine {
   std::vector<double> island_angular_velocity_;
   SweepWork sweep_work_;  // the islands' sweeps, each in its slice (its manifolds' place in islands_)
   std::vector<std::size_t> island_bundles_;  // coloured sweeps: each island's first bundle in sweep_work_
-  SweepPipeline sweep_pipeline_;  // the plain sweeps of the largest islands, on every thread
   static constexpr std::size_t kIslandGrain = 8;  // islands per block
   static constexpr std::size_t kPairGrain = 512;  // pairs per block (narrow phase, contact list)
   static constexpr std::size_t kPrefetchPairs = 4;  // the narrow phase and contact list read this many pairs ahead
@@ -692,25 +690,23 @@ void NativeEngine::solve_contacts() {
     resize_with_headroom(island_angular_velocity_, islands_.body_count());
   }
   for (IslandWork& w : island_work_) w.longest = w.cold_restarts = 0;
-  // An island with rows enough for several threads' worth (the packed field's one large island)
-  // is left out of the blocks and solved after them on every thread at once, its plain sweeps
-  // pipelined (sweep_pipeline.hpp), or its colours swept on every thread (coloured sweeps, NNCG
-  // or not): on two threads, the rest of the islands and it would otherwise wait for the one
-  // thread that has it.
-  const bool pipelined = thread_pool().size() > 1;
+  // A large island swept in colour order (the packed field's one large island) is left out of
+  // the blocks and solved after them on every thread at once, its colours swept on the pool:
+  // on two threads, the rest of the islands and it would otherwise wait for the one thread
+  // that has it.
+  const bool threads = thread_pool().size() > 1;
   auto large = [&](std::size_t i) {
-    return pipelined && (!settings_.accelerate || coloured(i)) &&
-           SweepPipeline::parts_for(2 * islands_.manifolds(i).size()) > 1;
+    return threads && coloured(i) && islands_.manifolds(i).size() >= kColouredOnThreads;
   };
   thread_pool().for_blocks(n, kIslandGrain, [&](std::size_t begin, std::size_t end) {
     IslandWork& w = island_work_[begin / kIslandGrain];
     for (std::size_t i = begin; i < end; ++i)
-      if (!large(i)) w.longest = std::max(w.longest, solve_island(i, checked, w, nullptr));
+      if (!large(i)) w.longest = std::max(w.longest, solve_island(i, checked, w, false));
   });
-  for (std::size_t i = 0; pipelined && i < n; ++i)
+  for (std::size_t i = 0; threads && i < n; ++i)
     if (large(i)) {
       IslandWork& w = island_work_[i / kIslandGrain];
-      w.longest = std::max(w.longest, solve_island(i, checked, w, &sweep_pipeline_));
+      w.longest = std::max(w.longest, solve_island(i, checked, w, true));
     }
   int longest = 0;
   for (const IslandWork& w : island_work_) {
@@ -726,7 +722,7 @@ void NativeEngine::solve_contacts() {
   if (heavy_light_ && longest >= settings_.velocity_iterations) solve_islands_directly(before);
 }
 
-int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& work, SweepPipeline* pipeline) {
+int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& work, bool threads) {
   // Gauss-Seidel from zero impulses cannot raise the kinetic energy: with a non-positive target
   // each local update moves the velocity to the constraint set along M^-1 J^T, which never
   // raises 1/2 v'Mv (a projection in the metric of M). Warm starting (last step's impulses
@@ -756,8 +752,8 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
   int sweeps = solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,
                                 {.warm_start = settings_.warm_start,
                                  .accelerate = settings_.accelerate,
-                                 .pipeline = pipeline,
-                                 .colour = colour});
+                                 .colour = colour,
+                                 .threads = threads});
   if (!checked) return sweeps;
   double pushed = 0.0;  // the work of towed bodies on this island's floes (contacts_gain_energy)
   if (has_prescribed_)
@@ -773,7 +769,7 @@ int NativeEngine::solve_island(std::size_t island, bool checked, IslandWork& wor
   }
   space.colours_given = false;  // the first solve kept its list of rows beyond the colours there: colour again
   sweeps += solve_velocities(manifolds_, manifolds, bodies_, sweep_limits(), space,  // plain sweeps: no energy made
-                             {.pipeline = pipeline, .colour = colour});
+                             {.colour = colour, .threads = threads});
   ++work.cold_restarts;
   return sweeps;
 }

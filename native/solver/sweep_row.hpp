@@ -1,8 +1,8 @@
 #pragma once
 // One Gauss-Seidel update of one contact row: the exact local solve of its 2x2 problem
 // (contact_solver.cpp states the conditions) and the impulse change applied to its bodies.
-// Shared by the serial sweeps (contact_solver.cpp) and the pipelined ones (sweep_pipeline.cpp),
-// so that both make the same arithmetic in the same order: the same impulses to the bit.
+// The sweeps in pair order (contact_solver.cpp), and the coloured sweeps' rows beyond their 63
+// colours (coloured_sweeps.cpp), sweep with it.
 #include <algorithm>
 #include <cmath>
 #include <span>

@@ -22,7 +22,6 @@
 #include "solver/narrow_phase.hpp"
 #include "solver/native_settings.hpp"
 #include "solver/part_set.hpp"
-#include "solver/sweep_pipeline.hpp"
 #include "parallel/thread_pool.hpp"
 #include "parallel/threads.hpp"
 
@@ -324,9 +323,9 @@ const PackedField& packed_field() {
 
 /// One step's contact sweeps on the packed field, timed: the warm start and 10 plain
 /// Gauss-Seidel sweeps (the speed benchmark's settings), from the same impulses and velocities
-/// each time; pipelined over the pool's threads with `pipeline`, or in colour order four
-/// manifolds at a time with `colour` (coloured_sweeps.hpp). Returns the contact points.
-std::size_t time_contact_sweeps(benchmark::State& state, SweepPipeline* pipeline, bool colour = false) {
+/// each time; in colour order four manifolds at a time with `colour` (coloured_sweeps.hpp), its
+/// colours on the pool's threads with `threads`. Returns the contact points.
+std::size_t time_contact_sweeps(benchmark::State& state, bool colour = false, bool threads = false) {
   const PackedField& field = packed_field();
   std::vector<Manifold> manifolds = field.manifolds;
   BodyArrays bodies = field.bodies;
@@ -342,7 +341,7 @@ std::size_t time_contact_sweeps(benchmark::State& state, SweepPipeline* pipeline
     state.ResumeTiming();
     sweeps = solve_velocities(manifolds, bodies, field.limits,
                               work.space(manifolds.size(), false, colour ? bodies.inv_mass.size() : 0),
-                              {.warm_start = true, .pipeline = pipeline, .colour = colour});
+                              {.warm_start = true, .colour = colour, .threads = threads});
     benchmark::DoNotOptimize(bodies.velocity.data());
   }
   state.counters["manifolds"] = static_cast<double>(manifolds.size());
@@ -354,25 +353,22 @@ std::size_t time_contact_sweeps(benchmark::State& state, SweepPipeline* pipeline
 }
 
 /// The sweeps on one thread. ns_per_point_sweep: the cost of one point's local solve.
-void BM_ContactSweeps(benchmark::State& state) { time_contact_sweeps(state, nullptr); }
+void BM_ContactSweeps(benchmark::State& state) { time_contact_sweeps(state); }
 BENCHMARK(BM_ContactSweeps)->Unit(benchmark::kMicrosecond);
 
 /// The sweeps in colour order, four manifolds at a time (`coloured_sweeps`), on one thread.
-void BM_ContactSweepsColoured(benchmark::State& state) { time_contact_sweeps(state, nullptr, true); }
+void BM_ContactSweepsColoured(benchmark::State& state) { time_contact_sweeps(state, true); }
 BENCHMARK(BM_ContactSweepsColoured)->Unit(benchmark::kMicrosecond);
 
-/// The same sweeps pipelined over a pool of state.range(0) threads (sweep_pipeline.hpp): the
-/// same impulses to the bit, in wall time (on a machine with fewer cores than threads, the
-/// threads take turns). parts: the threads the pipeline used. The pool is set back to
-/// FLOEDEM_THREADS after.
-void BM_ContactSweepsPipelined(benchmark::State& state) {
+/// The sweeps in colour order with each colour on a pool of state.range(0) threads: the same
+/// impulses to the bit, in wall time (on a machine with fewer cores than threads, the threads
+/// take turns). The pool is set back to FLOEDEM_THREADS after.
+void BM_ContactSweepsColouredThreads(benchmark::State& state) {
   set_thread_pool_size(static_cast<unsigned>(state.range(0)));
-  SweepPipeline pipeline;
-  const std::size_t points = time_contact_sweeps(state, &pipeline);
-  state.counters["parts"] = SweepPipeline::parts_for(points);
+  time_contact_sweeps(state, true, true);
   set_thread_pool_size(worker_threads());
 }
-BENCHMARK(BM_ContactSweepsPipelined)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_ContactSweepsColouredThreads)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 /// The narrow phase of one step on the packed field: every pair of the broad phase collided
 /// (no reuse of last step's manifolds, no separation hints). ns_per_pair: one pair's test.

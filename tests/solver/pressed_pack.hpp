@@ -1,6 +1,6 @@
 #pragma once
 // A pressed pack of box floes and its contact manifolds, built directly (no narrow phase): the
-// contact solver's tests (test_sweep_pipeline.cpp, test_coloured_sweeps.cpp) solve it.
+// contact solver's tests (test_coloured_sweeps.cpp) solve it.
 #include <algorithm>
 #include <cstdint>
 #include <cstring>

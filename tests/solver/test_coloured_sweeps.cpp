@@ -18,7 +18,6 @@
 #include "solver/coloured_sweeps.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/pressed_pack.hpp"
-#include "solver/sweep_pipeline.hpp"
 
 using namespace floedem;
 using namespace floedem::test;
@@ -30,16 +29,15 @@ struct Solved {
   int sweeps = 0;
 };
 
-// `threads`: each colour swept on the pool's threads (SweepOptions::pipeline set).
+// `threads`: each colour swept on the pool's threads (SweepOptions::threads).
 Solved solve(const Pack& start, const SweepLimits& limits, bool colour, bool accelerate = false,
              bool warm_start = true, bool threads = false) {
   Solved s{start, 0};
   SweepWork work;
-  SweepPipeline pipeline;
   s.sweeps = solve_velocities(
       s.state.manifolds, s.state.bodies, limits,
       work.space(s.state.manifolds.size(), accelerate, colour ? s.state.bodies.inv_mass.size() : 0),
-      {.warm_start = warm_start, .accelerate = accelerate, .pipeline = threads ? &pipeline : nullptr, .colour = colour});
+      {.warm_start = warm_start, .accelerate = accelerate, .colour = colour, .threads = threads});
   return s;
 }
 
