@@ -31,8 +31,9 @@
 //   velocity it does not reach, and the ice loads on held bodies are what users read. Its
 //   first step is a whole one.
 // - either, where h |D| / M >= 0.5 (a small floe at a long step): s = 1, linearly implicit
-//   (Rosenbrock-Euler: stable at any dt, first order), at q_n (an extrapolation by a stiff
-//   acceleration would not be stable); such a body relaxes to the flow within a few steps.
+//   (Rosenbrock-Euler: stable at any dt, first order); its acceleration is not kept, so from
+//   the step after it turned stiff it is seen at q_n (an extrapolation by a stiff acceleration
+//   would not be stable). Such a body relaxes to the flow within a few steps.
 // For a linear drag the steady state is the exact one in every case. The engines get
 // M_e (q_n+1 - q_n) / dt as constant loads, M_e the mass they move (m, or m_I when added mass
 // enters contacts); contacts then act by their impulse laws on top, unchanged.
