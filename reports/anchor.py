@@ -18,8 +18,7 @@ import os
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from sections.speed import EQUAL_ITERATIONS, equal  # noqa: E402
+from sections.speed import EQUAL_ITERATIONS, equal
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FIELDS = ["host", "cpu", "floedem_version", "scenario", "round", "engine", "settings", "median_ms",

@@ -169,6 +169,7 @@ class Forcing {
   /// was free and explicit, else zero: the next step takes its terms at q + (dt/2) a.
   std::vector<std::array<double, 3>> ahead_;
   bool any_ahead_ = false;  ///< some entry of ahead_ is not zero
+  void note_ahead();        ///< sets any_ahead_ from ahead_
 
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   /// The run of consecutive drag terms terms_[pass_first_, pass_first_ + pass_count_) that

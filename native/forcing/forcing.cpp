@@ -332,9 +332,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     dirty_.assign(moving.begin(), moving.end());
     have_dirty_ = true;
   }
-  any_ahead_ = std::any_of(ahead_.begin(), ahead_.end(), [](const std::array<double, 3>& a) {
-    return a[0] != 0.0 || a[1] != 0.0 || a[2] != 0.0;
-  });
+  note_ahead();
   return &loads_;
 }
 
@@ -405,6 +403,12 @@ void Forcing::load_body(std::size_t i, const BodyStates& state, bool first_step)
   loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
 }
 
+void Forcing::note_ahead() {
+  any_ahead_ = std::any_of(ahead_.begin(), ahead_.end(), [](const std::array<double, 3>& a) {
+    return a[0] != 0.0 || a[1] != 0.0 || a[2] != 0.0;
+  });
+}
+
 void Forcing::save(StateWriter& out) const {
   out.tag("forcing");
   out.vector(ahead_);
@@ -413,9 +417,7 @@ void Forcing::save(StateWriter& out) const {
 void Forcing::restore(StateReader& in) {
   in.tag("forcing");
   in.vector(ahead_, hot_.size(), "forcing: accelerations");
-  any_ahead_ = std::any_of(ahead_.begin(), ahead_.end(), [](const std::array<double, 3>& a) {
-    return a[0] != 0.0 || a[1] != 0.0 || a[2] != 0.0;
-  });
+  note_ahead();
 }
 
 }  // namespace floedem

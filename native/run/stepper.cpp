@@ -1,8 +1,10 @@
 #include "run/stepper.hpp"
 
 #include <algorithm>
+#include <numeric>
 
 #include "floedem/engine/registry.hpp"
+#include "geometry/polygon.hpp"
 
 namespace floedem {
 
@@ -16,40 +18,28 @@ namespace {
 // those that start before it ends.
 std::vector<std::uint8_t> touching_at_start(const Scene& scene) {
   const std::size_t n = scene.bodies.size();
-  struct Box {
-    Vec2 lo, hi;
-  };
-  std::vector<Box> box(n);
-  Vec2 lo_all{1e300, 1e300}, hi_all{-1e300, -1e300};
+  std::vector<Aabb> box(n);
+  Aabb all{{1e300, 1e300}, {-1e300, -1e300}};
   for (std::size_t i = 0; i < n; ++i) {
     const BodySpec& b = scene.bodies[i];
-    Box& x = box[i];
-    x.lo = x.hi = b.polygon.empty() ? b.centroid : b.polygon.front();
-    for (const Vec2 p : b.polygon) {
-      x.lo = {std::min(x.lo.x, p.x), std::min(x.lo.y, p.y)};
-      x.hi = {std::max(x.hi.x, p.x), std::max(x.hi.y, p.y)};
-    }
     const double grow = length(b.velocity) * scene.run.dt + 0.01;
-    x.lo -= Vec2{grow, grow};
-    x.hi += Vec2{grow, grow};
-    lo_all = {std::min(lo_all.x, x.lo.x), std::min(lo_all.y, x.lo.y)};
-    hi_all = {std::max(hi_all.x, x.hi.x), std::max(hi_all.y, x.hi.y)};
+    box[i] = b.polygon.empty() ? Aabb{b.centroid, b.centroid} : bounds_of(b.polygon);
+    box[i].lo -= Vec2{grow, grow};
+    box[i].hi += Vec2{grow, grow};
+    all = {{std::min(all.lo.x, box[i].lo.x), std::min(all.lo.y, box[i].lo.y)},
+           {std::max(all.hi.x, box[i].hi.x), std::max(all.hi.y, box[i].hi.y)}};
   }
-  const bool along_x = hi_all.x - lo_all.x >= hi_all.y - lo_all.y;
+  const bool along_x = all.hi.x - all.lo.x >= all.hi.y - all.lo.y;
   auto lo = [&](std::size_t i) { return along_x ? box[i].lo.x : box[i].lo.y; };
   auto hi = [&](std::size_t i) { return along_x ? box[i].hi.x : box[i].hi.y; };
   std::vector<std::size_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return lo(a) < lo(b); });
   std::vector<std::uint8_t> touching(n, 0);
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t a = order[k];
-    for (std::size_t j = k + 1; j < n && lo(order[j]) <= hi(a); ++j) {
-      const std::size_t b = order[j];
-      if (box[a].lo.x <= box[b].hi.x && box[b].lo.x <= box[a].hi.x && box[a].lo.y <= box[b].hi.y &&
-          box[b].lo.y <= box[a].hi.y)
-        touching[a] = touching[b] = 1;
-    }
+    for (std::size_t j = k + 1; j < n && lo(order[j]) <= hi(a); ++j)
+      if (box[a].overlaps(box[order[j]])) touching[a] = touching[order[j]] = 1;
   }
   return touching;
 }

@@ -9,6 +9,7 @@
 #include "engine/prefetch.hpp"
 #include "solver/coloured_sweeps.hpp"
 #include "solver/headroom.hpp"
+#include "solver/local_law.hpp"
 #include "solver/sweep_row.hpp"
 
 // Contact constraint, per point, between bodies a and b (normal n from a to b, tangent t = k x n):
@@ -37,7 +38,9 @@ namespace floedem {
 
 LocalImpulse solve_single_contact(double ufn, double uft, double target, double mu, double wnn, double wnt,
                                   double wtt) {
-  return local_impulse(ufn, uft, target, mu, wnn, wnt, wtt);
+  LocalImpulse r;
+  local_law<ScalarOps>(ufn, uft, target, mu, wnn, wnt, wtt, r.normal, r.tangent);
+  return r;
 }
 
 void prepare_contact(Manifold& m, const BodyArrays& s, double dt, double collision_threshold) {

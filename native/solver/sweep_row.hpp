@@ -12,13 +12,6 @@
 
 namespace floedem {
 
-/// The local law (local_law.hpp) on one point of its own (the impact suite's single contacts).
-inline LocalImpulse local_impulse(double ufn, double uft, double target, double mu, double wnn, double wnt, double wtt) {
-  LocalImpulse r;
-  local_law<ScalarOps>(ufn, uft, target, mu, wnn, wnt, wtt, r.normal, r.tangent);
-  return r;
-}
-
 /// Applies `impulse` (on the row's body b; its opposite on a) at the row's contact point.
 inline void apply_row_impulse(BodyArrays& s, const SweepRow& r, Vec2 impulse) {
   apply_impulse(s, r.body_a, r.body_b, r.ra, r.rb, impulse);
