@@ -54,12 +54,14 @@ void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays
   }
 
   // Islands numbered by their first manifold. A manifold between two bodies that cannot move
-  // (never paired by the broad phase) would be an island of its own.
+  // (two sleeping bodies, or a sleeping and a fixed one: the broad phase never pairs two fixed
+  // ones) is in no island: nothing can change its impulses, which stay as they were carried.
   std::int32_t islands = 0;
+  std::size_t held = 0;
   for (std::size_t k = 0; k < nm; ++k) {
     const std::int32_t b = manifold_island_[k];
     if (b < 0) {
-      manifold_island_[k] = islands++;
+      ++held;
       continue;
     }
     const std::int32_t r = find(b);
@@ -72,11 +74,13 @@ void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays
   reserve_with_headroom(fill_, static_cast<std::size_t>(islands) + 1);
   reserve_with_headroom(body_start_, static_cast<std::size_t>(islands) + 1);
   manifold_start_.assign(static_cast<std::size_t>(islands) + 1, 0);
-  for (const std::int32_t i : manifold_island_) ++manifold_start_[i + 1];
+  for (std::size_t k = 0; k < nm; ++k)
+    if (manifold_island_[k] >= 0) ++manifold_start_[manifold_island_[k] + 1];
   for (std::int32_t i = 0; i < islands; ++i) manifold_start_[i + 1] += manifold_start_[i];
   fill_.assign(manifold_start_.begin(), manifold_start_.end() - 1);
-  resize_with_headroom(manifold_, nm);
-  for (std::size_t k = 0; k < nm; ++k) manifold_[fill_[manifold_island_[k]]++] = static_cast<std::int32_t>(k);
+  resize_with_headroom(manifold_, nm - held);
+  for (std::size_t k = 0; k < nm; ++k)
+    if (manifold_island_[k] >= 0) manifold_[fill_[manifold_island_[k]]++] = static_cast<std::int32_t>(k);
 
   // The bodies in contact, ascending: sorted where they are few (the towing case), read off
   // the union-find in one pass where they are most of the scene (a packed field: the sort was

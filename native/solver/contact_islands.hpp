@@ -39,7 +39,7 @@ class ContactIslands {
   std::size_t body_count() const { return body_.size(); }
   /// Every island's moving bodies, island by island: each moving body of a manifold once.
   std::span<const std::int32_t> all_bodies() const { return body_; }
-  /// The island that holds manifold k's moving bodies.
+  /// The island that holds manifold k's moving bodies; -1 where neither moves (a held manifold).
   std::int32_t island_of_manifold(std::size_t k) const { return manifold_island_[k]; }
 
  private:

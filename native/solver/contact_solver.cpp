@@ -390,6 +390,7 @@ double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const
       const Vec2 rb = point - s.position[b];
       const double rna = cross(ra, n), rnb = cross(rb, n);
       const double k_eff = ma + mb + ia * rna * rna + ib * rnb * rnb;
+      if (k_eff == 0.0) continue;  // two sleeping bodies, or a sleeping and a fixed one: held as they are
       const Vec2 impulse = (-c / k_eff) * n;
       move(a, s.position[a] - ma * impulse, s.angle[a] - ia * cross(ra, impulse));
       move(b, s.position[b] + mb * impulse, s.angle[b] + ib * cross(rb, impulse));

@@ -106,7 +106,8 @@ bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays&
   manifolds_.clear();
   for (std::size_t mi = 0; mi < manifolds.size(); ++mi) {
     const Manifold& m = manifolds[mi];
-    if (!chosen_[static_cast<std::size_t>(islands_.island_of_manifold(mi))]) continue;
+    const std::int32_t island = islands_.island_of_manifold(mi);
+    if (island < 0 || !chosen_[static_cast<std::size_t>(island)]) continue;
     manifolds_.push_back(static_cast<std::int32_t>(mi));
     for (int k = 0; k < m.point_count; ++k) points_.push_back({static_cast<std::int32_t>(mi), k, m.body_a, m.body_b});
   }

@@ -1,5 +1,5 @@
 // The native planar non-smooth DEM. One step (NativeEngine::step) makes the stages of
-// floedem/engine/step_stages.hpp from broad_phase to record, in that list's order; docs/architecture.md
+// floedem/engine/step_stages.hpp from broad_phase to sleep, in that list's order; docs/architecture.md
 // describes what each reads and writes.
 #include "solver/native_engine.hpp"
 
@@ -69,6 +69,8 @@ class NativeEngine final : public Engine {
 
  private:
   void find_pairs(const Loads* loads);
+  void set_reach(const Loads* loads);  // each body's reach this step, from its velocity after the loads
+  bool set_reach(std::size_t body, const Loads* loads);  // ... one body's; whether it changed
   void pair_up();  // parts placed at the bodies' positions (unchanged within a step)
   bool outran_reach();
   bool meets_unseen_contact();
@@ -79,6 +81,13 @@ class NativeEngine final : public Engine {
   void apply_loads(const Loads& loads);
   void integrate();
   void record();
+  // Sleeping (NativeSettings::sleep; docs/model.md, sleeping).
+  bool asleep(std::int32_t b) const { return sleep_group_[static_cast<std::size_t>(b)] >= 0; }
+  void wake_group(std::int32_t group);
+  bool wake_on_loads(const Loads* loads);
+  bool wake_touched();
+  void fall_asleep(bool solved);
+  void sleep_group(std::span<const std::int32_t> bodies);
   PartGeometry part_geometry(std::int32_t k) const;
   double reach_of_part(std::int32_t k) const;
   Aabb reach_box(std::int32_t k, double reach) const;
@@ -103,11 +112,11 @@ class NativeEngine final : public Engine {
   ContactSettings contact_;
   double dt_;
   // Wall time per stage of step(), when asked for (floedem bench): the stages of
-  // floedem/engine/step_stages.hpp from broad_phase to record, in step()'s order.
+  // floedem/engine/step_stages.hpp from broad_phase to sleep, in step()'s order.
   enum Stage : std::size_t {
-    kBroad, kNarrow, kContactList, kLoads, kSolve, kRedetect, kIntegrate, kProject, kRecord, kStages
+    kBroad, kNarrow, kContactList, kLoads, kSolve, kRedetect, kIntegrate, kProject, kRecord, kSleep, kStages
   };
-  static_assert(step_stage("record") - step_stage("broad_phase") + 1 == kStages);
+  static_assert(step_stage("sleep") - step_stage("broad_phase") + 1 == kStages);
   StageClock<kStages> stages_{step_stage_names<kStages>(step_stage("broad_phase"))};
 
   // Hot: touched every step.
@@ -157,6 +166,7 @@ class NativeEngine final : public Engine {
   std::int64_t cold_restarts_ = 0;
   std::int64_t redetections_ = 0;          // steps whose contacts were found again (outran reach)
   static constexpr int kMaxRedetections = 4;  // a struck floe striking the next, and so on
+  static constexpr int kMaxWakePasses = 8;    // a woken group's reach meeting the next sleeping group, and so on
   static constexpr int kFrictionRounds = 8;   // cut friction, solve the normals again (drift_in_field: 88 % of solves cut nothing, 99 % within 2 rounds)
   std::int64_t direct_solves_ = 0;    // steps whose islands were solved directly
   std::int64_t direct_reverted_ = 0;  // ... and then given back (they would have made energy)
@@ -183,6 +193,26 @@ class NativeEngine final : public Engine {
   std::vector<std::int32_t> island_index_;  // the manifolds of the islands solved directly
   std::vector<Manifold> island_manifolds_;  // ... copied out for their sweeps
   IslandSolver island_solver_;
+  // Sleeping. A sleeping body is held as a fixed one is: zero velocity, zero inverse mass and
+  // inertia in bodies_ (so the islands, the solve, the loads and the projection pass it by and
+  // its contacts with sleeping or fixed bodies keep their impulses), its own kept here.
+  std::vector<double> own_inv_mass_, own_inv_inertia_;  // 0 for fixed and prescribed bodies
+  std::vector<double> body_radius_;        // farthest point of a body from its centroid, m
+  std::vector<double> rest_time_;          // s each moving body has been at rest (sleep_speed)
+  std::vector<std::int32_t> sleep_group_;  // per body: its sleeping group, -1 awake
+  // Each group's bodies as a list through the bodies (no allocation as groups come and go):
+  // its first body (-1: a free id), and per body the next of its group (-1: the last).
+  std::vector<std::int32_t> group_first_, next_in_group_;
+  std::vector<std::int32_t> free_groups_;
+  std::vector<Vec2> sleep_force_;          // per sleeping body: its load at its first step asleep (NaN: not yet seen)
+  std::vector<double> sleep_torque_;
+  std::vector<std::uint8_t> in_island_;    // scratch of fall_asleep
+  std::int64_t asleep_count_ = 0;          // bodies asleep now
+  std::int64_t asleep_steps_ = 0;          // sum over steps of the bodies asleep (info: mean fraction)
+  std::int64_t wakes_ = 0;                 // groups woken over the run
+  const Loads* step_loads_ = nullptr;      // this step's loads (nullptr: none) ...
+  bool loads_applied_ = false;             // ... and whether apply_loads has run: a group woken after it gets its loads then
+  bool wake_reach_grew_ = false;           // a body woken in the narrow phase has another reach than asleep
   /// The sweeps' limits: extra sweeps while a point would close by more than the allowed overlap within the step.
   SweepLimits sweep_limits() const {
     return {settings_.velocity_iterations, settings_.tolerance, settings_.extra_iterations,
@@ -222,6 +252,21 @@ NativeEngine::NativeEngine(const Scene& scene)
     }
   }
   heavy_light_ = settings_.direct_solve && heaviest >= settings_.direct_solve_mass_ratio * lightest;
+  own_inv_mass_ = bodies_.inv_mass;
+  own_inv_inertia_ = bodies_.inv_inertia;
+  body_radius_.assign(n, 0.0);
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    const auto b = static_cast<std::size_t>(parts_.body()[k]);
+    body_radius_[b] = std::max(body_radius_[b], parts_.radius(static_cast<std::int32_t>(k)));
+  }
+  rest_time_.assign(n, 0.0);
+  sleep_group_.assign(n, -1);
+  sleep_force_.assign(n, Vec2{});
+  sleep_torque_.assign(n, 0.0);
+  next_in_group_.assign(n, -1);
+  group_first_.reserve(n);
+  free_groups_.reserve(n);
+  in_island_.assign(n, 0);
   part_boxes_.resize(parts_.size());
   linear_reach_.resize(n);
   angular_reach_.resize(n);
@@ -249,6 +294,11 @@ EngineInfo NativeEngine::info() const {
       {"redetect", settings_.redetect ? "true" : "false"},
       {"direct_solve", settings_.direct_solve ? "true" : "false"},
       {"direct_solve_mass_ratio", setting_text(settings_.direct_solve_mass_ratio)},
+      {"sleep", settings_.sleep ? "true" : "false"},
+      {"sleep_speed", setting_text(settings_.sleep_speed)},
+      {"sleep_time", setting_text(settings_.sleep_time)},
+      {"mean_bodies_asleep", setting_text(steps_ > 0 ? static_cast<double>(asleep_steps_) / static_cast<double>(steps_) : 0.0)},
+      {"sleeping_groups_woken", std::to_string(wakes_)},
       {"direct_solves", std::to_string(direct_solves_)},
       {"direct_solves_reverted", std::to_string(direct_reverted_)},
       {"mean_sweeps_per_step", setting_text(steps_ > 0 ? static_cast<double>(total_sweeps_) / static_cast<double>(steps_) : 0.0)},
@@ -295,6 +345,13 @@ bool NativeEngine::save_state(StateWriter& out) const {
   out.value(total_islands_);
   out.value(narrow_pairs_);
   out.value(narrow_reused_);
+  out.tag("sleep");
+  out.vector(rest_time_);
+  out.vector(sleep_group_);
+  out.vector(sleep_force_);
+  out.vector(sleep_torque_);
+  out.value(asleep_steps_);
+  out.value(wakes_);
   return true;
 }
 
@@ -334,6 +391,34 @@ void NativeEngine::restore_state(StateReader& in) {
   in.value(total_islands_);
   in.value(narrow_pairs_);
   in.value(narrow_reused_);
+  in.tag("sleep");
+  in.vector(rest_time_, n, "rest times");
+  in.vector(sleep_group_, n, "sleeping groups");
+  in.vector(sleep_force_, n, "sleeping loads");
+  in.vector(sleep_torque_, n, "sleeping torques");
+  in.value(asleep_steps_);
+  in.value(wakes_);
+  // The groups again from each body's (the ids as saved; which ids are free, and the order of
+  // a group's list, change no result).
+  group_first_.clear();
+  free_groups_.clear();
+  asleep_count_ = 0;
+  for (std::size_t b = 0; b < n; ++b) {
+    const std::int32_t g = sleep_group_[b];
+    next_in_group_[b] = -1;
+    if (g < 0) continue;
+    if (g >= static_cast<std::int32_t>(n) || own_inv_mass_[b] == 0.0) throw StateError("checkpoint: a sleeping body that does not fit this scene");
+    if (static_cast<std::size_t>(g) >= group_first_.size()) group_first_.resize(static_cast<std::size_t>(g) + 1, -1);
+    next_in_group_[b] = group_first_[static_cast<std::size_t>(g)];
+    group_first_[static_cast<std::size_t>(g)] = static_cast<std::int32_t>(b);
+    ++asleep_count_;
+  }
+  for (std::size_t g = group_first_.size(); g-- > 0;)
+    if (group_first_[g] < 0) free_groups_.push_back(static_cast<std::int32_t>(g));
+  for (std::size_t b = 0; b < n; ++b) {
+    bodies_.inv_mass[b] = sleep_group_[b] >= 0 ? 0.0 : own_inv_mass_[b];
+    bodies_.inv_inertia[b] = sleep_group_[b] >= 0 ? 0.0 : own_inv_inertia_[b];
+  }
   records_.clear();  // the contacts of the step before the checkpoint are not needed again
   forget_narrow();   // a restored run computes its first narrow phase afresh, as the saved one did
 }
@@ -346,12 +431,26 @@ void NativeEngine::step(const Loads* loads) {
     }
     if (!loads->any && loads->velocity_turn.empty()) loads = nullptr;  // nothing to add: skip the pass
   }
+  step_loads_ = loads && loads->any ? loads : nullptr;
+  loads_applied_ = false;
+  // 0. a sleeping group whose loads changed wakes (before the reaches: it moves this step)
+  if (asleep_count_ > 0) stages_.time(kSleep, [&] { wake_on_loads(step_loads_); });
   // 1. pairs (a velocity turn keeps the speed)
-  stages_.time(kBroad, [&] { find_pairs(loads && loads->any ? loads : nullptr); });
-  // 2. manifolds, classified on the velocities before the step
-  stages_.time(kNarrow, [&] { collide_pairs(/*redetection=*/false); });
+  stages_.time(kBroad, [&] { find_pairs(step_loads_); });
+  // 2. manifolds, classified on the velocities before the step; a sleeping group that an awake
+  // body reaches wakes, and the pairs are found again with its reach
+  stages_.time(kNarrow, [&] {
+    collide_pairs(/*redetection=*/false);
+    wake_reach_grew_ = false;
+    for (int pass = 0; asleep_count_ > 0 && pass < kMaxWakePasses && wake_touched() && wake_reach_grew_; ++pass) {
+      wake_reach_grew_ = false;
+      pair_up();
+      collide_pairs(/*redetection=*/false);
+    }
+  });
   stages_.time(kContactList, [&] { build_contact_list(); });
   if (loads) stages_.time(kLoads, [&] { apply_loads(*loads); });  // 3. non-contact forces
+  loads_applied_ = true;
   if (!manifolds_.empty()) {                                       // 4. contact impulses
     stages_.time(kSolve, [&] { solve_contacts(); });
     // A body the impulses sent further than its reach may meet one the pairs did not include
@@ -369,6 +468,7 @@ void NativeEngine::step(const Loads* loads) {
         apply_accumulated_impulses(manifolds_, bodies_, -1.0);
         pair_up();
         collide_pairs(/*redetection=*/true);
+        if (asleep_count_ > 0) wake_touched();  // a body struck into a sleeping one wakes it (with its loads)
         build_contact_list();
         solve_contacts();
         ++redetections_;
@@ -379,6 +479,8 @@ void NativeEngine::step(const Loads* loads) {
   if (settings_.position_iterations > 0 && !manifolds_.empty())  // 6. drift correction, positions only
     stages_.time(kProject, [&] { solve_positions(manifolds_, bodies_, settings_, projection_); });
   stages_.time(kRecord, [&] { record(); });  // 7. impulses for the recorder
+  if (settings_.sleep) stages_.time(kSleep, [&] { fall_asleep(!manifolds_.empty()); });  // 8. islands at rest
+  asleep_steps_ += asleep_count_;
   ++steps_;
 }
 
@@ -450,23 +552,31 @@ bool NativeEngine::meets_unseen_contact() {
 }
 
 void NativeEngine::find_pairs(const Loads* loads) {
+  set_reach(loads);
+  any_kept_ = parts_.place(bodies_.position, bodies_.rotation);
+  pair_up();
+}
+
+void NativeEngine::set_reach(const Loads* loads) {
   // Reach: how far any point of a body can travel this step (dt times its speed after the
   // loads, plus spin times the part's radius), so that contacts are found before the bodies
   // would overlap (speculative contact) and their bounds need no rebuild within the step.
   thread_pool().for_blocks(bodies_.position.size(), 8192, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      double speed = length(bodies_.velocity[i]);
-      double spin = std::abs(bodies_.angular_velocity[i]);
-      if (loads) {
-        speed += dt_ * length(loads->force[i]) * bodies_.inv_mass[i];
-        spin += dt_ * std::abs(loads->torque[i]) * bodies_.inv_inertia[i];
-      }
-      linear_reach_[i] = dt_ * speed;
-      angular_reach_[i] = dt_ * spin;
-    }
+    for (std::size_t i = begin; i < end; ++i) set_reach(i, loads);
   });
-  any_kept_ = parts_.place(bodies_.position, bodies_.rotation);
-  pair_up();
+}
+
+bool NativeEngine::set_reach(std::size_t i, const Loads* loads) {
+  double speed = length(bodies_.velocity[i]);
+  double spin = std::abs(bodies_.angular_velocity[i]);
+  if (loads) {
+    speed += dt_ * length(loads->force[i]) * bodies_.inv_mass[i];
+    spin += dt_ * std::abs(loads->torque[i]) * bodies_.inv_inertia[i];
+  }
+  const bool same = same_bits(linear_reach_[i], dt_ * speed) && same_bits(angular_reach_[i], dt_ * spin);
+  linear_reach_[i] = dt_ * speed;
+  angular_reach_[i] = dt_ * spin;
+  return !same;
 }
 
 void NativeEngine::forget_narrow() {
@@ -629,7 +739,10 @@ void NativeEngine::build_contact_list() {
             // Pressed last step: the bodies are already in contact here, so this is no collision.
             m.points[q].persistent = prev.normal_impulse[j] > 0.0;
             // Only resting impulses are a good first guess: a collision's impulse is a one-off.
-            if (settings_.warm_start && prev.kind[j] == ContactKind::resting) {
+            // A manifold between two held bodies (sleeping or fixed) keeps its impulses whatever
+            // the warm start: nothing solves it, and they are the load it carries.
+            const bool held = bodies_.inv_mass[m.body_a] == 0.0 && bodies_.inv_mass[m.body_b] == 0.0;
+            if ((settings_.warm_start || held) && prev.kind[j] == ContactKind::resting) {
               m.points[q].normal_impulse = prev.normal_impulse[j];
               m.points[q].tangent_impulse = prev.tangent_impulse[j];
             }
@@ -941,6 +1054,159 @@ void NativeEngine::record() {
   }
 }
 
+
+void NativeEngine::sleep_group(std::span<const std::int32_t> bodies) {
+  std::int32_t g = 0;
+  if (free_groups_.empty()) {
+    g = static_cast<std::int32_t>(group_first_.size());
+    group_first_.push_back(-1);
+  } else {
+    g = free_groups_.back();
+    free_groups_.pop_back();
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const std::int32_t b : bodies) {
+    next_in_group_[b] = group_first_[static_cast<std::size_t>(g)];
+    group_first_[static_cast<std::size_t>(g)] = b;
+    sleep_group_[b] = g;
+    bodies_.velocity[b] = Vec2{};
+    bodies_.angular_velocity[b] = 0.0;
+    bodies_.inv_mass[b] = bodies_.inv_inertia[b] = 0.0;
+    sleep_force_[b] = Vec2{nan, nan};  // taken at its first step asleep, at rest
+    sleep_torque_[b] = nan;
+  }
+  asleep_count_ += static_cast<std::int64_t>(bodies.size());
+}
+
+void NativeEngine::wake_group(std::int32_t group) {
+  std::int64_t count = 0;
+  for (std::int32_t b = group_first_[static_cast<std::size_t>(group)]; b >= 0; b = next_in_group_[b], ++count) {
+    sleep_group_[b] = -1;
+    rest_time_[b] = 0.0;
+    bodies_.inv_mass[b] = own_inv_mass_[b];
+    bodies_.inv_inertia[b] = own_inv_inertia_[b];
+    // Woken in the narrow phase: its loads may give it a reach it did not have asleep, and
+    // then the step's pairs are found again (at rest in calm water it keeps none).
+    if (!loads_applied_) wake_reach_grew_ = set_reach(static_cast<std::size_t>(b), step_loads_) || wake_reach_grew_;
+    // Woken after the loads were applied (by a body the impulses sent into it): its own now.
+    if (loads_applied_ && step_loads_) {
+      bodies_.velocity[b] += (dt_ * bodies_.inv_mass[b]) * step_loads_->force[b];
+      bodies_.angular_velocity[b] += dt_ * bodies_.inv_inertia[b] * step_loads_->torque[b];
+    }
+  }
+  asleep_count_ -= count;
+  group_first_[static_cast<std::size_t>(group)] = -1;
+  free_groups_.push_back(group);
+  ++wakes_;
+}
+
+bool NativeEngine::wake_on_loads(const Loads* loads) {
+  // A sleeping body's load (forcing and applied loads) against the one it had at its first step
+  // asleep: a change that would move it faster than the balance tolerance (below) wakes its
+  // group. Steady wind and current on a body that does not move give the same load to the bit;
+  // a changing wind, a wave or a load switched on does not.
+  const double slack = 1e-3 * settings_.sleep_speed / settings_.sleep_time;  // m/s^2
+  bool woke = false;
+  for (std::size_t b = 0; b < sleep_group_.size(); ++b) {
+    const std::int32_t g = sleep_group_[b];
+    if (g < 0) continue;
+    const Vec2 f = loads ? loads->force[b] : Vec2{};
+    const double t = loads ? loads->torque[b] : 0.0;
+    if (std::isnan(sleep_torque_[b])) {
+      sleep_force_[b] = f;
+      sleep_torque_[b] = t;
+      continue;
+    }
+    if (length(f - sleep_force_[b]) * own_inv_mass_[b] > slack ||
+        std::abs(t - sleep_torque_[b]) * own_inv_inertia_[b] * body_radius_[b] > slack) {
+      wake_group(g);
+      woke = true;
+    }
+  }
+  return woke;
+}
+
+bool NativeEngine::wake_touched() {
+  // A pair with contact points (speculative ones included: within the reach of this step)
+  // between a sleeping body and an awake one that moves wakes the sleeping body's group; and
+  // again over the pairs, while any woke (a woken group touching the next).
+  bool woke = false;
+  for (bool again = true; again;) {
+    again = false;
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+      if (narrow_points_[k] == 0) continue;
+      const std::int32_t a = parts_.body()[pairs_[k].a], b = parts_.body()[pairs_[k].b];
+      const bool sa = asleep(a), sb = asleep(b);
+      if (sa == sb) continue;
+      const std::int32_t sleeper = sa ? a : b, other = sa ? b : a;
+      if (!moves_[other]) continue;
+      wake_group(sleep_group_[sleeper]);
+      again = woke = true;
+    }
+  }
+  return woke;
+}
+
+void NativeEngine::fall_asleep(bool solved) {
+  // The rule (docs/model.md, sleeping): a moving body is at rest in a step when no point of it
+  // moves faster than sleep_speed (|v| + |w| r, r its farthest point from the centroid). An
+  // island (bodies joined by contacts) whose every body has been at rest for sleep_time falls
+  // asleep, unless a towed body touches it or nothing holds it: an island without a contact with
+  // a fixed (or sleeping) body must carry a net load below the balance tolerance, as must a body
+  // without contacts. A body out of balance by more than sleep_speed / sleep_time leaves the
+  // speed within sleep_time, so the tolerance on loads, a thousandth of that, is what the timer
+  // cannot see for itself: about 1.7e-10 m/s^2 at the defaults.
+  const std::size_t n = bodies_.position.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (own_inv_mass_[i] == 0.0 || sleep_group_[i] >= 0) continue;
+    const double fastest = length(bodies_.velocity[i]) + std::abs(bodies_.angular_velocity[i]) * body_radius_[i];
+    rest_time_[i] = fastest <= settings_.sleep_speed ? rest_time_[i] + dt_ : 0.0;
+  }
+  if (has_prescribed_)
+    for (const Manifold& m : manifolds_) {
+      const bool towed_a = moves_[m.body_a] && own_inv_mass_[m.body_a] == 0.0;
+      const bool towed_b = moves_[m.body_b] && own_inv_mass_[m.body_b] == 0.0;
+      if (towed_a) rest_time_[m.body_b] = 0.0;
+      if (towed_b) rest_time_[m.body_a] = 0.0;
+    }
+  const double slack = 1e-3 * settings_.sleep_speed / settings_.sleep_time;  // m/s^2
+  const double rest = settings_.sleep_time * (1.0 - 1e-9);  // a sum of steps, to rounding
+  auto force = [&](std::int32_t b) { return step_loads_ ? step_loads_->force[b] : Vec2{}; };
+  for (std::size_t i = 0; solved && i < islands_.size(); ++i) {
+    const std::span<const std::int32_t> bodies = islands_.bodies(i);
+    bool rested = true;
+    for (const std::int32_t b : bodies) {
+      in_island_[b] = 1;
+      rested = rested && rest_time_[b] >= rest;
+    }
+    if (!rested) continue;
+    bool held = false;
+    for (const std::int32_t k : islands_.manifolds(i)) {
+      const Manifold& m = manifolds_[k];
+      held = held || bodies_.inv_mass[m.body_a] == 0.0 || bodies_.inv_mass[m.body_b] == 0.0;
+    }
+    if (!held) {
+      Vec2 net{};
+      double mass = 0.0;
+      for (const std::int32_t b : bodies) {
+        net += force(b);
+        mass += 1.0 / own_inv_mass_[b];
+      }
+      if (length(net) > slack * mass) continue;
+    }
+    sleep_group(bodies);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (own_inv_mass_[i] == 0.0 || sleep_group_[i] >= 0 || in_island_[i] || rest_time_[i] < rest) continue;
+    const auto b = static_cast<std::int32_t>(i);
+    const double torque = step_loads_ ? step_loads_->torque[i] : 0.0;
+    if (length(force(b)) * own_inv_mass_[i] > slack || std::abs(torque) * own_inv_inertia_[i] * body_radius_[i] > slack)
+      continue;
+    sleep_group({&b, 1});
+  }
+  if (solved)
+    for (const std::int32_t b : islands_.all_bodies()) in_island_[b] = 0;  // for the next step
+}
 
 }  // namespace
 

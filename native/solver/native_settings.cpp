@@ -26,6 +26,9 @@ NativeSettings read_native_settings(const Scene& scene) {
   s.redetect = r.boolean("redetect", s.redetect);
   s.direct_solve = r.boolean("direct_solve", s.direct_solve);
   s.direct_solve_mass_ratio = r.real("direct_solve_mass_ratio", s.direct_solve_mass_ratio, Range{1.0, std::numeric_limits<double>::infinity(), false, true});
+  s.sleep = r.boolean("sleep", s.sleep);
+  s.sleep_speed = r.real("sleep_speed", s.sleep_speed, Range::positive());
+  s.sleep_time = r.real("sleep_time", s.sleep_time, Range::positive());
   r.reject_unknown();
   return s;
 }

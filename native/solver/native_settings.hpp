@@ -24,6 +24,12 @@ struct NativeSettings {
   bool redetect = true;              ///< find the step's contacts again when impulses send a body beyond its reach
   bool direct_solve = true;          ///< heavy-light islands Gauss-Seidel cannot hold get their normals solved directly
   double direct_solve_mass_ratio = 300.0;  ///< ... islands whose heaviest body is at least this times their lightest
+  /// Islands at rest sleep (no loads, solve or motion; their contacts held) until touched or
+  /// their loads change: the rule and its tolerances in docs/model.md. false: every body
+  /// is stepped every step (bit-for-bit studies against an older run or another engine).
+  bool sleep = true;
+  double sleep_speed = 1e-5;         ///< m/s, fastest point of a body that counts as at rest
+  double sleep_time = 60.0;          ///< s, how long every body of an island must be at rest before it sleeps
 };
 
 /// Reads [engine.native] from the scene (defaults for what is absent); InputError if bad.

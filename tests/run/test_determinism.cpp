@@ -101,7 +101,7 @@ TEST_CASE("determinism: timing the stages changes nothing, and the stages add up
   INFO("engine " << engine);
   const std::map<std::string, std::vector<std::string>> expected = {
       {"native", {"forcing", "broad_phase", "narrow_phase", "contact_list", "loads", "contact_solve", "redetect",
-                  "integrate", "position_projection", "record", "towing"}},
+                  "integrate", "position_projection", "record", "sleep", "towing"}},
       {"box2d", {"forcing", "loads", "narrow_phase", "contact_solve", "islands_integrate", "broad_phase", "toi",
                  "step_other", "publish", "towing"}}};
   const Scene s = load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml",

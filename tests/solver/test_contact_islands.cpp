@@ -67,6 +67,18 @@ TEST_CASE("contact islands: manifolds join through moving bodies, never through 
   CHECK(list(islands.bodies(1)) == std::vector<std::int32_t>{1, 2});
   islands.build({}, bodies);
   CHECK(islands.size() == 0);
+
+  // Bodies 5 and 6 asleep (held like fixed ones): their manifold with each other and with the
+  // fixed body are in no island, and the rest are numbered as if those were absent.
+  bodies.inv_mass[5] = bodies.inv_mass[6] = bodies.inv_inertia[5] = bodies.inv_inertia[6] = 0.0;
+  const std::vector<Manifold> held{joining(5, 6), joining(1, 2), joining(0, 6), joining(2, 3)};
+  islands.build(held, bodies);
+  REQUIRE(islands.size() == 1);
+  CHECK(list(islands.manifolds(0)) == std::vector<std::int32_t>{1, 3});
+  CHECK(list(islands.bodies(0)) == std::vector<std::int32_t>{1, 2, 3});
+  CHECK(islands.island_of_manifold(0) == -1);
+  CHECK(islands.island_of_manifold(2) == -1);
+  CHECK(islands.body_count() == 3);
 }
 
 TEST_CASE("contact islands: an island's solve does not depend on the rest of the scene", "[islands]") {

@@ -15,7 +15,7 @@ struct StepStage {
   const char* what;   ///< what it does, in one line
 };
 
-inline constexpr std::array<StepStage, 11> kStepStages{{
+inline constexpr std::array<StepStage, 12> kStepStages{{
     {"forcing", "forcing (environment terms)",
      "every force term evaluated on the state at the start of the step (run/stepper.cpp, forcing/)"},
     {"broad_phase", "broad phase",
@@ -33,6 +33,7 @@ inline constexpr std::array<StepStage, 11> kStepStages{{
     {"position_projection", "position projection",
      "overlap beyond the allowed penetration removed on positions only (no velocity, no energy)"},
     {"record", "record", "the step's impulses as contact records; what the next contact list carries"},
+    {"sleep", "sleep", "islands at rest for the sleep time fall asleep (held, not stepped) until touched or their loads change"},
     {"towing", "towing", "the tow's force and its ice part, before and after the engine's step (towing/tow.cpp)"},
 }};
 

@@ -1,0 +1,158 @@
+// Sleeping islands (engine.native.sleep; docs/model.md, sleeping): what falls asleep, what it
+// carries while asleep, what wakes it, and that a checkpoint holds it.
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <string>
+
+#include "support.hpp"
+
+using namespace floedem;
+using test::BodyText;
+
+namespace {
+
+// Engine settings for these scenes: a short sleep time, so that a test sees several.
+std::string sleep_settings(bool on, double time = 2.0) {
+  return "[engine.native]\nsleep = " + std::string(on ? "true" : "false") + "\nsleep_time = " + std::to_string(time) + "\n";
+}
+
+double asleep(const Engine& e) { return std::stod(e.info().settings.at("mean_bodies_asleep")); }
+long woken(const Engine& e) { return std::stol(e.info().settings.at("sleeping_groups_woken")); }
+
+Loads loads_on(std::size_t n, std::size_t body, Vec2 force) {
+  Loads l;
+  l.force.assign(n, Vec2{});
+  l.torque.assign(n, 0.0);
+  l.force[body] = force;
+  l.any = true;
+  return l;
+}
+
+bool same_state(const BodyStates& a, const BodyStates& b) {
+  auto same = [](const auto& x, const auto& y) {
+    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
+  };
+  return same(a.position, b.position) && same(a.angle, b.angle) && same(a.velocity, b.velocity) &&
+         same(a.angular_velocity, b.angular_velocity);
+}
+
+constexpr double kPush = 2e4;  // N
+
+std::string pushed_floe(bool sleep) {
+  return test::header_toml(60.0, 0.01, 0.3, 0.3, sleep_settings(sleep)) +
+         test::body_toml({"floe", test::box({5, 5}, 10, 10)}) +
+         test::body_toml({"wall", test::box({11, 5}, 2, 40), {}, 0.0, true});
+}
+
+}  // namespace
+
+TEST_CASE("sleep: a floe pushed on a wall sleeps carrying the push, and wakes when the push turns", "[sleep]") {
+  const Scene s = test::scene_from(pushed_floe(true));
+  auto e = test::native(s);
+  const Loads push = loads_on(2, 0, {kPush, 0.0});
+  for (int k = 0; k < 1000; ++k) e->step(&push);  // 10 s: at rest within a step, asleep after 2 s more
+  REQUIRE(asleep(*e) > 0.5);
+  // Asleep: not moved, and the wall still carries the push (the held contact's impulses).
+  const Vec2 at = e->state().position[0];
+  for (int k = 0; k < 100; ++k) {
+    e->step(&push);
+    REQUIRE(e->state().position[0].x == at.x);
+    REQUIRE(e->state().velocity[0].x == 0.0);
+    // 0.1 %: the resting contact's tolerance (test_resting.cpp); held, it is the same impulse.
+    REQUIRE(std::abs(-test::contact_force_x(*e, 0, 0.01) - kPush) <= 1e-3 * kPush);
+  }
+  // The push turned: the floe wakes in the same step and leaves the wall at F dt / m.
+  const Loads pull = loads_on(2, 0, {-kPush, 0.0});
+  e->step(&pull);
+  CHECK(woken(*e) == 1);
+  const double mass = 900.0 * 100.0;
+  CHECK(e->state().velocity[0].x == Approx(-kPush * 0.01 / mass).epsilon(1e-12));
+  CHECK(e->state().position[0].x < at.x);
+}
+
+TEST_CASE("sleep: a floe struck by a moving one wakes, and the impact is the same to the bit", "[sleep]") {
+  // The struck floe is at rest with no load: asleep it is exactly where it was, so waking it
+  // when the other comes within reach must give the run without sleeping, to the bit.
+  auto scene = [](bool sleep) {
+    return test::scene_from(test::header_toml(20.0, 0.01, 0.3, 0.3, sleep_settings(sleep, 1.0)) +
+                            test::body_toml({"struck", test::box({0, 0}, 10, 10)}) +
+                            test::body_toml({"striker", test::box({13, 1}, 10, 10, 0.1), {-0.5, 0.0}, 0.02}));
+  };
+  const Scene on = scene(true), off = scene(false);
+  auto a = test::native(on);
+  auto b = test::native(off);
+  bool struck = false;
+  for (int k = 0; k < 2000; ++k) {
+    a->step(nullptr);
+    b->step(nullptr);
+    REQUIRE(same_state(a->state(), b->state()));
+    struck = struck || !a->contacts().empty();
+  }
+  CHECK(struck);
+  CHECK(woken(*a) == 1);
+  CHECK(asleep(*a) > 0.0);
+  CHECK(a->state().velocity[0].x < 0.0);
+}
+
+TEST_CASE("sleep: a free floe under a load too small for the timer does not sleep", "[sleep]") {
+  // 1e-8 m/s^2 keeps the floe under sleep_speed (1e-5 m/s) for 1 000 s, far past sleep_time:
+  // the balance test (a body without contacts needs no load) keeps it awake.
+  const Scene s = test::scene_from(test::header_toml(400.0, 1.0, 0.3, 0.3, sleep_settings(true, 60.0)) +
+                                   test::body_toml({"floe", test::box({0, 0}, 10, 10)}));
+  auto e = test::native(s);
+  const double mass = 900.0 * 100.0;
+  const Loads creep = loads_on(1, 0, {1e-8 * mass, 0.0});
+  for (int k = 0; k < 400; ++k) e->step(&creep);
+  CHECK(asleep(*e) == 0.0);
+  CHECK(e->state().velocity[0].x == Approx(400 * 1e-8).epsilon(1e-9));
+}
+
+TEST_CASE("sleep: two floes in contact drifting under a small common load do not sleep", "[sleep]") {
+  // Joined by a contact but held by nothing: their net load must be below the balance test's.
+  const Scene s = test::scene_from(test::header_toml(400.0, 1.0, 0.0, 0.3, sleep_settings(true, 60.0)) +
+                                   test::body_toml({"a", test::box({0, 0}, 10, 10)}) +
+                                   test::body_toml({"b", test::box({10.0005, 0}, 10, 10)}));
+  auto e = test::native(s);
+  const double mass = 900.0 * 100.0;
+  Loads creep = loads_on(2, 0, {1e-8 * mass, 0.0});
+  creep.force[1] = creep.force[0];
+  for (int k = 0; k < 400; ++k) e->step(&creep);
+  CHECK(asleep(*e) == 0.0);
+  CHECK(e->state().velocity[1].x == Approx(400 * 1e-8).epsilon(1e-6));
+  // Pressed together by opposite loads, the same pair balances and sleeps.
+  Loads press = loads_on(2, 0, {1e-3 * mass, 0.0});
+  press.force[1] = -press.force[0];
+  auto f = test::native(s);
+  for (int k = 0; k < 400; ++k) f->step(&press);
+  CHECK(asleep(*f) > 0.5);
+}
+
+TEST_CASE("sleep: a checkpoint with sleeping bodies continues to the bit", "[sleep]") {
+  const Scene s = test::scene_from(pushed_floe(true) + test::body_toml({"drifter", test::box({-15, 5}, 8, 8), {0.3, 0.0}}));
+  const Loads push = loads_on(3, 0, {kPush, 0.0});
+  auto a = test::native(s);
+  for (int k = 0; k < 800; ++k) a->step(&push);  // the floe asleep, the drifter on its way to it
+  REQUIRE(asleep(*a) > 0.0);
+  StateWriter out;
+  REQUIRE(a->save_state(out));
+  auto b = test::native(s);
+  StateReader in(out.bytes().data(), out.bytes().size());
+  b->restore_state(in);
+  for (int k = 0; k < 6000; ++k) {  // the drifter strikes the sleeping floe and wakes it
+    a->step(&push);
+    b->step(&push);
+    REQUIRE(same_state(a->state(), b->state()));
+  }
+  CHECK(woken(*a) >= 1);
+  CHECK(a->info().settings.at("sleeping_groups_woken") == b->info().settings.at("sleeping_groups_woken"));
+}
+
+TEST_CASE("sleep: a scene switch turns it off", "[sleep]") {
+  const Scene s = test::scene_from(pushed_floe(false));
+  auto e = test::native(s);
+  const Loads push = loads_on(2, 0, {kPush, 0.0});
+  for (int k = 0; k < 1000; ++k) e->step(&push);
+  CHECK(asleep(*e) == 0.0);
+  CHECK(e->info().settings.at("sleep") == "false");
+}
