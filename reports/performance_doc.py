@@ -102,11 +102,14 @@ def read(name):
 
 
 def kind(row):
-    """What a bench row is: "sweep" (a point of the iterations/dt sweep), "equal" (the field at
-    equal iterations: engine settings given), or "plain" (the scene's own settings)."""
+    """What a bench row is: "sweep" (a point of the iterations/dt sweep), "sleep" (native with
+    sleeping islands switched on or off), "equal" (the field at equal iterations: engine settings
+    given), or "plain" (the scene's own settings)."""
     sets = row["overrides"].split()
     if any(o.startswith("run.dt") for o in sets):
         return "sweep"
+    if any(o.startswith("engine.native.sleep=") for o in sets):
+        return "sleep"
     return "equal" if any(o.startswith("engine.") for o in sets) else "plain"
 
 
@@ -281,6 +284,15 @@ def render():
                "|---|---|---|---|"]
         md += [f"| `{r['scenario']}` | {r['bodies']} | {fmt(float(r['median_ms']))} | "
                f"{1e3 * float(r['max_penetration_m']):.3g} |" for r in sorted(mine, key=lambda r: int(r["bodies"]))]
+        md += [""]
+    asleep = [r for r in bench if kind(r) == "sleep"]
+    if asleep:
+        md += ["Sleeping islands (`engine.native.sleep`, on by default) against every body stepped every step, "
+               "native, mean ms a step over the window (what a run's length goes by):", "",
+               "| case | sleep | mean ms a step | median | deepest penetration (mm) |", "|---|---|---|---|---|"]
+        md += [f"| `{r['scenario']}` | {'on' if 'engine.native.sleep=true' in r['overrides'].split() else 'off'} | "
+               f"{fmt(float(r['mean_ms']))} | {fmt(float(r['median_ms']))} | {1e3 * float(r['max_penetration_m']):.3g} |"
+               for r in asleep]
         md += [""]
     md += ["Where native's step goes (mean ms a step by stage, single thread; the stages of "
            "[architecture.md](architecture.md)):", ""] + stage_table(compared) + [""]

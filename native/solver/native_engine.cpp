@@ -1157,11 +1157,17 @@ void NativeEngine::fall_asleep(bool solved) {
   // speed within sleep_time, so the tolerance on loads, a thousandth of that, is what the timer
   // cannot see for itself: about 1.7e-10 m/s^2 at the defaults.
   const std::size_t n = bodies_.position.size();
+  const double rest = settings_.sleep_time * (1.0 - 1e-9);  // a sum of steps, to rounding
+  bool ready = false;  // any awake body at rest for sleep_time (else nothing more to look at)
   for (std::size_t i = 0; i < n; ++i) {
     if (own_inv_mass_[i] == 0.0 || sleep_group_[i] >= 0) continue;
-    const double fastest = length(bodies_.velocity[i]) + std::abs(bodies_.angular_velocity[i]) * body_radius_[i];
-    rest_time_[i] = fastest <= settings_.sleep_speed ? rest_time_[i] + dt_ : 0.0;
+    // |v| + |w| r <= sleep_speed, without the square root: |v|^2 <= (sleep_speed - |w| r)^2.
+    const double left = settings_.sleep_speed - std::abs(bodies_.angular_velocity[i]) * body_radius_[i];
+    const Vec2 v = bodies_.velocity[i];
+    rest_time_[i] = left >= 0.0 && v.x * v.x + v.y * v.y <= left * left ? rest_time_[i] + dt_ : 0.0;
+    ready = ready || rest_time_[i] >= rest;
   }
+  if (!ready) return;
   if (has_prescribed_)
     for (const Manifold& m : manifolds_) {
       const bool towed_a = moves_[m.body_a] && own_inv_mass_[m.body_a] == 0.0;
@@ -1170,7 +1176,6 @@ void NativeEngine::fall_asleep(bool solved) {
       if (towed_b) rest_time_[m.body_a] = 0.0;
     }
   const double slack = 1e-3 * settings_.sleep_speed / settings_.sleep_time;  // m/s^2
-  const double rest = settings_.sleep_time * (1.0 - 1e-9);  // a sum of steps, to rounding
   auto force = [&](std::int32_t b) { return step_loads_ ? step_loads_->force[b] : Vec2{}; };
   for (std::size_t i = 0; solved && i < islands_.size(); ++i) {
     const std::span<const std::int32_t> bodies = islands_.bodies(i);

@@ -52,12 +52,12 @@ def config(quick):
     # an hour: docs/performance.md), and the 16k ratio is a target, so it is taken from two pairs of
     # adjacent runs (native, box2d ... box2d, native), not from one.
     if quick:   # a smoke run of the machinery: the field is not packed yet at 40 s
-        return dict(field=[("1k", 40.0, 20.0)], again="1k", towing=(60.0, 30.0),
+        return dict(field=[("1k", 40.0, 20.0)], again="1k", towing=(60.0, 30.0), jam=(900.0, 600.0),
                     sweep=dict(duration=40.0, window=20.0, iterations=[3, 30], dts=[0.1]))
     # Packed by about 100 s (99 % of floes in contact); the larger fields are timed over a short
     # window after that, so that the section stays within half an hour on 2 cores.
     return dict(field=[("1k", 150.0, 50.0), ("4k", 150.0, 50.0), ("16k", 110.0, 10.0), ("100k", 105.0, 5.0)],
-                again="16k", towing=(300.0, 240.0),
+                again="16k", towing=(300.0, 240.0), jam=(21600.0, 21000.0),
                 sweep=dict(duration=150.0, window=50.0, iterations=[2, 5, 20, 50], dts=[0.025, 0.1, 0.2]))
 
 
@@ -94,6 +94,15 @@ def plan(ctx):
         runs.append(Run(f"speed_towing_{e}", os.path.join(ctx.scenarios, "towing_paper.toml"), e,
                         [f"run.duration={duration!r}"], bench_window=window, bench_stages=True,
                         meta=dict(scene="towing")))
+    # Sleeping (docs/model.md, section 3): native with islands at rest asleep (its default) and
+    # without, on the jam (the whole 6 h after its first 10 min, when the pack has come to rest)
+    # and on the towing case (as timed above).
+    for scene, path, (duration, window) in (("jam", os.path.join("stress", "jam.toml"), c["jam"]),
+                                            ("towing", "towing_paper.toml", c["towing"])):
+        for on in (True, False):
+            runs.append(Run(f"speed_sleep_{scene}_{'on' if on else 'off'}", os.path.join(ctx.scenarios, path), "native",
+                            [f"run.duration={duration!r}", f"engine.native.sleep={'true' if on else 'false'}"],
+                            bench_window=window, bench_stages=True, meta=dict(scene="sleep")))
     return runs
 
 
@@ -116,7 +125,9 @@ def write_rows(path, rows):
 def write(ctx):
     timed = [r for r in ctx.all_runs if r.timed and r.tag.startswith("speed_")]
     every = {r.tag: read_row(r.out) for r in timed}
-    rows = {t: r for t, r in every.items() if not t.startswith(("speed_sweep_", "speed_again_", "speed_default_"))}
+    rows = {t: r for t, r in every.items()
+            if not t.startswith(("speed_sweep_", "speed_again_", "speed_default_", "speed_sleep_"))}
+    sleeping = {t: r for t, r in every.items() if t.startswith("speed_sleep_")}
     defaults = {t: r for t, r in every.items() if t.startswith("speed_default_")}
     again = {t: r for t, r in every.items() if t.startswith("speed_again_")}
     # All rows in one CSV per report (the machine is in each row).
@@ -152,6 +163,7 @@ def write(ctx):
     md.append("")
     md += repeated(rows, again)
     md += targets(rows, again)
+    md += sleep_table(sleeping)
     figure(ctx, rows, defaults)
     md += ["![ms per step against floes](fig/speed_field.png)", ""]
     md += stages_section(ctx, rows, every)
@@ -178,6 +190,30 @@ def defaults_table(defaults, rows):
                   f"{float(row['p10_ms']):.2f}-{float(row['p90_ms']):.2f} | "
                   f"{1e3 * float(row['max_penetration_m']):.2f} | {1e3 * float(row['mean_penetration_m']):.3f} | "
                   + " | ".join(cells) + " |")
+    return md + [""]
+
+
+def sleep_table(sleeping):
+    """Native with islands at rest asleep (its default) against every body stepped every step."""
+    if not sleeping:
+        return []
+    md = ["Sleeping islands (docs/model.md, section 3; `engine.native.sleep`): native's defaults against every "
+          "body stepped every step, on the jam (a pack at rest after its first minutes) and the towing case (the "
+          "floes far from the iceberg at rest). The mean is what a run's length goes by: a step of a pack that has "
+          "fallen asleep costs its forcing, broad phase and held contacts only.", "",
+          "| scene | sleep | ms per step (median) | mean | p10-p90 | max penetration (mm) | mean overlap (mm) | "
+          "mean: off / on |", "|---|---|---|---|---|---|---|---|"]
+    for scene in ("jam", "towing"):
+        on, off = sleeping.get(f"speed_sleep_{scene}_on"), sleeping.get(f"speed_sleep_{scene}_off")
+        for label, row in (("on", on), ("off", off)):
+            if row is None:
+                continue
+            gain = (f"{float(off['mean_ms']) / float(on['mean_ms']):.2f}"
+                    if label == "on" and off is not None else "")
+            md.append(f"| {scene} | {label} | {float(row['median_ms']):.3f} | {float(row['mean_ms']):.3f} | "
+                      f"{float(row['p10_ms']):.3f}-{float(row['p90_ms']):.3f} | "
+                      f"{1e3 * float(row['max_penetration_m']):.2f} | {1e3 * float(row['mean_penetration_m']):.3f} | "
+                      f"{gain} |")
     return md + [""]
 
 
