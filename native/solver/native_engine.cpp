@@ -208,7 +208,7 @@ class NativeEngine final : public Engine {
   std::vector<double> sleep_torque_;
   std::vector<std::uint8_t> in_island_;    // scratch of fall_asleep
   std::int64_t asleep_count_ = 0;          // bodies asleep now
-  std::int64_t asleep_steps_ = 0;          // sum over steps of the bodies asleep (info: mean fraction)
+  std::int64_t asleep_steps_ = 0;          // sum over steps of the bodies asleep (info: their mean)
   std::int64_t wakes_ = 0;                 // groups woken over the run
   const Loads* step_loads_ = nullptr;      // this step's loads (nullptr: none) ...
   bool loads_applied_ = false;             // ... and whether apply_loads has run: a group woken after it gets its loads then
