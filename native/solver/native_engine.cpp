@@ -88,6 +88,13 @@ class NativeEngine final : public Engine {
   bool wake_touched();
   void fall_asleep(bool solved);
   void sleep_group(std::span<const std::int32_t> bodies);
+  // The balance tolerance, m/s^2: a thousandth of the speed the timer sees over sleep_time.
+  double balance_tolerance() const { return 1e-3 * settings_.sleep_speed / settings_.sleep_time; }
+  // Whether a load (f, t) on body b moves its fastest point beyond the balance tolerance.
+  bool out_of_balance(std::size_t b, Vec2 f, double t) const {
+    return length(f) * own_inv_mass_[b] > balance_tolerance() ||
+           std::abs(t) * own_inv_inertia_[b] * body_radius_[b] > balance_tolerance();
+  }
   PartGeometry part_geometry(std::int32_t k) const;
   double reach_of_part(std::int32_t k) const;
   Aabb reach_box(std::int32_t k, double reach) const;
@@ -406,6 +413,8 @@ void NativeEngine::restore_state(StateReader& in) {
   for (std::size_t b = 0; b < n; ++b) {
     const std::int32_t g = sleep_group_[b];
     next_in_group_[b] = -1;
+    bodies_.inv_mass[b] = g >= 0 ? 0.0 : own_inv_mass_[b];
+    bodies_.inv_inertia[b] = g >= 0 ? 0.0 : own_inv_inertia_[b];
     if (g < 0) continue;
     if (g >= static_cast<std::int32_t>(n) || own_inv_mass_[b] == 0.0) throw StateError("checkpoint: a sleeping body that does not fit this scene");
     if (static_cast<std::size_t>(g) >= group_first_.size()) group_first_.resize(static_cast<std::size_t>(g) + 1, -1);
@@ -415,10 +424,6 @@ void NativeEngine::restore_state(StateReader& in) {
   }
   for (std::size_t g = group_first_.size(); g-- > 0;)
     if (group_first_[g] < 0) free_groups_.push_back(static_cast<std::int32_t>(g));
-  for (std::size_t b = 0; b < n; ++b) {
-    bodies_.inv_mass[b] = sleep_group_[b] >= 0 ? 0.0 : own_inv_mass_[b];
-    bodies_.inv_inertia[b] = sleep_group_[b] >= 0 ? 0.0 : own_inv_inertia_[b];
-  }
   records_.clear();  // the contacts of the step before the checkpoint are not needed again
   forget_narrow();   // a restored run computes its first narrow phase afresh, as the saved one did
 }
@@ -1105,7 +1110,6 @@ bool NativeEngine::wake_on_loads(const Loads* loads) {
   // asleep: a change that would move it faster than the balance tolerance (below) wakes its
   // group. Steady wind and current on a body that does not move give the same load to the bit;
   // a changing wind, a wave or a load switched on does not.
-  const double slack = 1e-3 * settings_.sleep_speed / settings_.sleep_time;  // m/s^2
   bool woke = false;
   for (std::size_t b = 0; b < sleep_group_.size(); ++b) {
     const std::int32_t g = sleep_group_[b];
@@ -1117,8 +1121,7 @@ bool NativeEngine::wake_on_loads(const Loads* loads) {
       sleep_torque_[b] = t;
       continue;
     }
-    if (length(f - sleep_force_[b]) * own_inv_mass_[b] > slack ||
-        std::abs(t - sleep_torque_[b]) * own_inv_inertia_[b] * body_radius_[b] > slack) {
+    if (out_of_balance(b, f - sleep_force_[b], t - sleep_torque_[b])) {
       wake_group(g);
       woke = true;
     }
@@ -1175,7 +1178,6 @@ void NativeEngine::fall_asleep(bool solved) {
       if (towed_a) rest_time_[m.body_b] = 0.0;
       if (towed_b) rest_time_[m.body_a] = 0.0;
     }
-  const double slack = 1e-3 * settings_.sleep_speed / settings_.sleep_time;  // m/s^2
   auto force = [&](std::int32_t b) { return step_loads_ ? step_loads_->force[b] : Vec2{}; };
   for (std::size_t i = 0; solved && i < islands_.size(); ++i) {
     const std::span<const std::int32_t> bodies = islands_.bodies(i);
@@ -1197,16 +1199,14 @@ void NativeEngine::fall_asleep(bool solved) {
         net += force(b);
         mass += 1.0 / own_inv_mass_[b];
       }
-      if (length(net) > slack * mass) continue;
+      if (length(net) > balance_tolerance() * mass) continue;
     }
     sleep_group(bodies);
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (own_inv_mass_[i] == 0.0 || sleep_group_[i] >= 0 || in_island_[i] || rest_time_[i] < rest) continue;
     const auto b = static_cast<std::int32_t>(i);
-    const double torque = step_loads_ ? step_loads_->torque[i] : 0.0;
-    if (length(force(b)) * own_inv_mass_[i] > slack || std::abs(torque) * own_inv_inertia_[i] * body_radius_[i] > slack)
-      continue;
+    if (out_of_balance(i, force(b), step_loads_ ? step_loads_->torque[i] : 0.0)) continue;
     sleep_group({&b, 1});
   }
   if (solved)
