@@ -100,7 +100,8 @@ FLOEDEM_LANES BundleRun start(const SweepBundle& b, const Vec2* v, const double*
 }
 
 // Point k of a bundle: its local solve and impulse. Returns |dP|^2 per lane (NNCG's merit: the
-// caller adds it in point order); with `change` (NNCG), each lane's impulse change into it.
+// caller adds it in point order); with `change` (NNCG: the bundle's kBundleNncg values), the
+// lanes' impulse changes into it, n then t (an empty lane's is zero).
 FLOEDEM_LANES v4d sweep_point(SweepBundle& b, int k, BundleRun& r, v4d& largest_change, v4d& largest_impulse,
                               double* change) {
   BundlePoint& p = b.point[k];
@@ -122,12 +123,8 @@ FLOEDEM_LANES v4d sweep_point(SweepBundle& b, int k, BundleRun& r, v4d& largest_
   largest_change = max(largest_change, abs(dpn) + abs(dpt));
   largest_impulse = max(largest_impulse, pn + abs(pt));
   if (change == nullptr) return splat(0.0);
-  for (int l = 0; l < kBundleLanes; ++l) {
-    if (b.manifold[l] < 0) continue;
-    double* const c = change + 4 * b.manifold[l] + 2 * k;
-    c[0] = dpn[l];
-    c[1] = dpt[l];
-  }
+  store(change + 2 * kBundleLanes * k, dpn);
+  store(change + 2 * kBundleLanes * k + kBundleLanes, dpt);
   return dpn * dpn + dpt * dpt;
 }
 
@@ -137,7 +134,7 @@ FLOEDEM_LANES void finish(const SweepBundle& b, const BundleRun& r, Vec2* v, dou
 }
 
 // One Gauss-Seidel sweep over the bundles, in order; with `change` (NNCG), each point's
-// impulse change into it (4 values a manifold: point, n or t). The bundles are one colour's:
+// impulse change into it (kBundleNncg values a bundle, in the bundles' order). The bundles are one colour's:
 // no two share a moving body, so the order in which their points are solved does not change
 // what any computes. Two are solved side by side, point k of one beside point k of the other:
 // each bundle's points are one chain of dependent operations (its bodies' velocities), over
@@ -160,14 +157,16 @@ FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, d
     // Near the span's end: the colour's next block, or past the array (never faults).
     prefetch_record(bundles.data(), i + kSweepAhead, 2 * sizeof(SweepBundle));
     BundleRun r0 = start(b0, v, w), r1 = start(b1, v, w);
+    double* const c0 = change == nullptr ? nullptr : change + kBundleNncg * i;
+    double* const c1 = change == nullptr ? nullptr : c0 + kBundleNncg;
     v4d sq0[2], sq1[2];
     const int both = std::min(b0.points, b1.points);
     for (int k = 0; k < both; ++k) {
-      sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, change);
-      sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, change);
+      sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, c0);
+      sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, c1);
     }
-    for (int k = both; k < b0.points; ++k) sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, change);
-    for (int k = both; k < b1.points; ++k) sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, change);
+    for (int k = both; k < b0.points; ++k) sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, c0);
+    for (int k = both; k < b1.points; ++k) sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, c1);
     if (change != nullptr) {
       for (int k = 0; k < b0.points; ++k) size = size + sq0[k];
       for (int k = 0; k < b1.points; ++k) size = size + sq1[k];
@@ -178,8 +177,9 @@ FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, d
   if (i < bundles.size()) {
     SweepBundle& b = bundles[i];
     BundleRun r = start(b, v, w);
+    double* const c = change == nullptr ? nullptr : change + kBundleNncg * i;
     for (int k = 0; k < b.points; ++k) {
-      const v4d sq = sweep_point(b, k, r, largest_change, largest_impulse, change);
+      const v4d sq = sweep_point(b, k, r, largest_change, largest_impulse, c);
       if (change != nullptr) size = size + sq;
     }
     finish(b, r, v, w);
@@ -534,6 +534,8 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
   Vec2* const v = s.velocity.data();
   double* const w = s.angular_velocity.data();
   SweepResult total;
+  // The NNCG values of the bundle `first` (of the solve's) on.
+  auto at = [&](std::size_t first) { return change == nullptr ? nullptr : change + kBundleNncg * first; };
   auto add = [&](const SweepResult& r) {
     total.largest_change = std::max(total.largest_change, r.largest_change);
     total.largest_impulse = std::max(total.largest_impulse, r.largest_impulse);
@@ -545,56 +547,105 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
     if (colour.empty()) break;  // colours are taken lowest first: none after an empty one
     if (!threads || colour.size() < kPoolBlocks * kBlock) {
       for (std::size_t b = 0; b < colour.size(); b += kBlock)
-        add(sweep_once(colour.subspan(b, std::min(kBlock, colour.size() - b)), v, w, change));
+        add(sweep_once(colour.subspan(b, std::min(kBlock, colour.size() - b)), v, w, at(g.colour_start[c] + b)));
       continue;
     }
     const std::size_t count = (colour.size() + kBlock - 1) / kBlock;
     if (blocks.size() < count) blocks.resize(count + count / 2);  // no allocation per step once grown
     thread_pool().for_blocks(colour.size(), kBlock, [&](std::size_t begin, std::size_t end) {
-      blocks[begin / kBlock] = sweep_once(colour.subspan(begin, end - begin), v, w, change);
+      blocks[begin / kBlock] = sweep_once(colour.subspan(begin, end - begin), v, w, at(g.colour_start[c] + begin));
     });
     for (std::size_t b = 0; b < count; ++b) add(blocks[b]);
   }
   return total;
 }
 
-// The NNCG step beta p added to the impulses (contact_solver.cpp, run_sweeps): over the dense
-// arrays (per manifold), then applied bundle by bundle where any lane's step is not zero. The
-// rows beyond the colours take no step: their changes are not recorded, so their direction
-// stays zero (they are swept plainly; only a body with more than 63 contacts has them).
-void conjugate_step(std::span<SweepBundle> bundles, BodyArrays& s, double beta, std::span<double> direction,
-                    std::span<const double> change, std::span<double> step) {
-  for (std::size_t i = 0; i < direction.size(); ++i) {
-    step[i] = beta * direction[i];
-    direction[i] = step[i] + change[i];
-  }
-  Vec2* const v = s.velocity.data();
-  double* const w = s.angular_velocity.data();
-  for (SweepBundle& b : bundles) {
-    // The lanes' steps, per point: normal and tangent.
-    double sn[2][kBundleLanes] = {}, st[2][kBundleLanes] = {};
-    bool any = false;
-    for (int l = 0; l < kBundleLanes; ++l) {
-      if (b.manifold[l] < 0) continue;
-      const double* const x = step.data() + 4 * b.manifold[l];
-      for (int k = 0; k < b.points; ++k) {
-        sn[k][l] = x[2 * k];
-        st[k][l] = x[2 * k + 1];
-        any = any || sn[k][l] != 0.0 || st[k][l] != 0.0;
-      }
+// The NNCG step beta p (contact_solver.cpp, run_sweeps) over a run of bundles, in order: each
+// bundle's values step = beta p and p = step + r (run_sweeps' dense loop, the same operation on
+// each value), then its step applied where any lane's is not zero (a bundle whose points neither
+// moved nor carry a direction costs no look at its bodies). The rows beyond the colours take no
+// step: their changes are not recorded, so their direction stays zero (they are swept plainly;
+// only a body with more than 63 contacts has them). A value past a bundle's points, or of an
+// empty lane, is zero from the solve's start and stays so.
+FLOEDEM_LANES void step_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, double beta, double* direction,
+                              const double* change, double* step) {
+  const v4d scale = splat(beta);
+  for (std::size_t j = 0; j < bundles.size(); ++j) {
+    double* const p = direction + kBundleNncg * j;
+    const double* const r = change + kBundleNncg * j;
+    double* const x = step + kBundleNncg * j;
+    v4m moves{};
+    for (std::size_t q = 0; q < kBundleNncg; q += kBundleLanes) {
+      const v4d stepped = scale * load(p + q);
+      store(x + q, stepped);
+      store(p + q, stepped + load(r + q));
+      moves = moves | (v4m)(stepped != 0.0);
     }
-    if (!any) continue;
+    if ((moves[0] | moves[1] | moves[2] | moves[3]) == 0) continue;
+    SweepBundle& b = bundles[j];
     Side a_side = gather(b.body_a, v, w), b_side = gather(b.body_b, v, w);
     const v4d nx = load(b.nx), ny = load(b.ny);
     for (int k = 0; k < b.points; ++k) {
-      BundlePoint& p = b.point[k];
-      const v4d n_step = load(sn[k]), t_step = load(st[k]);
-      apply(b, p, n_step * nx + t_step * -ny, n_step * ny + t_step * nx, a_side, b_side);
-      store(p.normal_impulse, load(p.normal_impulse) + n_step);
-      store(p.tangent_impulse, load(p.tangent_impulse) + t_step);
+      BundlePoint& pt = b.point[k];
+      const v4d n_step = load(x + 2 * kBundleLanes * k), t_step = load(x + 2 * kBundleLanes * k + kBundleLanes);
+      apply(b, pt, n_step * nx + t_step * -ny, n_step * ny + t_step * nx, a_side, b_side);
+      store(pt.normal_impulse, load(pt.normal_impulse) + n_step);
+      store(pt.tangent_impulse, load(pt.tangent_impulse) + t_step);
     }
     scatter(b.body_a, b.ma, a_side, v, w);
     scatter(b.body_b, b.mb, b_side, v, w);
+  }
+}
+
+// Built for each instruction set as the sweep is (the same values to the bit).
+void step_baseline(std::span<SweepBundle> bundles, Vec2* v, double* w, double beta, double* direction,
+                   const double* change, double* step) {
+  step_lanes(bundles, v, w, beta, direction, change, step);
+}
+#ifdef FLOEDEM_HAS_AVX2_SWEEP
+[[gnu::target("avx2")]] void step_avx2(std::span<SweepBundle> bundles, Vec2* v, double* w, double beta,
+                                       double* direction, const double* change, double* step) {
+  step_lanes(bundles, v, w, beta, direction, change, step);
+}
+[[gnu::target("avx2,avx512f,avx512vl")]] void step_avx512(std::span<SweepBundle> bundles, Vec2* v, double* w,
+                                                          double beta, double* direction, const double* change,
+                                                          double* step) {
+  step_lanes(bundles, v, w, beta, direction, change, step);
+}
+#endif
+
+void step_once(std::span<SweepBundle> bundles, Vec2* v, double* w, double beta, double* direction,
+               const double* change, double* step) {
+  switch (lane_isa()) {
+#ifdef FLOEDEM_HAS_AVX2_SWEEP
+    case LaneIsa::avx512: return step_avx512(bundles, v, w, beta, direction, change, step);
+    case LaneIsa::avx2: return step_avx2(bundles, v, w, beta, direction, change, step);
+#endif
+    default: return step_baseline(bundles, v, w, beta, direction, change, step);
+  }
+}
+
+// The step over every bundle, colour by colour, a large colour's blocks on the pool's threads
+// as the sweep's: bundles of one colour share no moving body, and the pool returns before the
+// next colour, so each body's velocity takes its steps in the order one thread gives them (the
+// same step to the bit on any number of threads).
+void conjugate_step(std::span<SweepBundle> bundles, const Gathered& g, BodyArrays& s, double beta,
+                    std::span<double> direction, std::span<const double> change, std::span<double> step,
+                    bool threads) {
+  Vec2* const v = s.velocity.data();
+  double* const w = s.angular_velocity.data();
+  for (int c = 0; c < kColours; ++c) {
+    const std::size_t first = g.colour_start[c], count = g.colour_start[c + 1] - first;
+    if (count == 0) break;  // colours are taken lowest first
+    auto run = [&](std::size_t begin, std::size_t end) {
+      const std::size_t at = kBundleNncg * (first + begin);
+      step_once(bundles.subspan(first + begin, end - begin), v, w, beta, direction.data() + at, change.data() + at,
+                step.data() + at);
+    };
+    if (!threads || count < kPoolBlocks * kBlock)
+      run(0, count);
+    else
+      thread_pool().for_blocks(count, kBlock, run);
   }
 }
 
@@ -612,16 +663,20 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
                    bool threads, bool given_order) {
   const Selection m{manifolds, island};
   if (space.rows.size() < 2 * m.size() || space.overflow.size() < m.size() ||
-      space.body_colours.size() < s.inv_mass.size() || (accelerate && space.change.size() < 4 * m.size()))
+      space.body_colours.size() < s.inv_mass.size())
     throw std::logic_error("solve_velocities: the sweep space has no room for the coloured sweeps");
   const Gathered g = gather_bundles(m, s, warm_start, /*two_points_first=*/!accelerate && !given_order, space, threads);
   const std::span<SweepBundle> bundles = space.bundles.first(g.bundles);
   const std::span<SweepRow> rows = space.rows.first(g.rows);
   std::span<double> change, direction, step;
   if (accelerate) {
-    change = space.change.first(4 * m.size());
-    direction = space.direction.first(4 * m.size());
-    step = space.step.first(4 * m.size());
+    const std::size_t values = kBundleNncg * g.bundles;
+    if (space.bundle_change.size() < values || space.bundle_direction.size() < values ||
+        space.bundle_step.size() < values)
+      throw std::logic_error("solve_velocities: the sweep space has no room for the coloured NNCG values");
+    change = space.bundle_change.first(values);
+    direction = space.bundle_direction.first(values);
+    step = space.bundle_step.first(values);
     std::fill(change.begin(), change.end(), 0.0);
     std::fill(direction.begin(), direction.end(), 0.0);
   }
@@ -647,7 +702,8 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
     if (previous_size > 0.0 && r.size > previous_size)
       std::fill(direction.begin(), direction.end(), 0.0);  // the merit rose: restart
     else
-      conjugate_step(bundles, s, previous_size > 0.0 ? r.size / previous_size : 0.0, direction, change, step);
+      conjugate_step(bundles, g, s, previous_size > 0.0 ? r.size / previous_size : 0.0, direction, change, step,
+                     threads);
     previous_size = r.size;
   }
   scatter_bundles(m, bundles, rows, space.overflow.first(g.overflow));

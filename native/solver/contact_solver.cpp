@@ -265,6 +265,11 @@ void SweepWork::reserve(std::size_t manifolds, bool accelerate, std::size_t colo
   }
   if (colour_bodies > 0) {
     grow(bundles_, bundles);
+    if (accelerate) {
+      grow(bundle_change_, kBundleNncg * bundles);
+      grow(bundle_direction_, kBundleNncg * bundles);
+      grow(bundle_step_, kBundleNncg * bundles);
+    }
     grow(overflow_, manifolds);
     if (body_colours_.size() < colour_bodies) body_colours_.resize(colour_bodies, 0);  // zero, and kept zero by each solve
   }
@@ -281,7 +286,10 @@ SweepSpace SweepWork::slice(std::size_t first, std::size_t count, std::size_t bu
           part(step_, 4 * first, 4 * count),
           part(bundles_, bundle_first, bundle_count),
           part(overflow_, first, count),
-          std::span<std::uint64_t>(body_colours_)};
+          std::span<std::uint64_t>(body_colours_),
+          part(bundle_change_, kBundleNncg * bundle_first, kBundleNncg * bundle_count),
+          part(bundle_direction_, kBundleNncg * bundle_first, kBundleNncg * bundle_count),
+          part(bundle_step_, kBundleNncg * bundle_first, kBundleNncg * bundle_count)};
 }
 
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepSpace space,

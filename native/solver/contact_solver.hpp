@@ -95,11 +95,13 @@ struct SweepSpace {
   /// solve's bundles (bundles_for(manifolds) at most); per manifold, room for the list of those
   /// beyond the 63 colours, swept as rows (in `rows`); and per body (the whole scene's, by body
   /// id) the colours its manifolds took so far, all zero between solves: islands share no
-  /// moving body, so islands solved side by side write disjoint entries of it. The NNCG arrays
-  /// above serve it too (per manifold: point, n or t).
+  /// moving body, so islands solved side by side write disjoint entries of it. Its NNCG arrays
+  /// are per bundle (kBundleNncg doubles: point, n or t, lane), in the bundles' order, so that
+  /// the sweep stores a bundle's changes as two vectors and the step reads them in order.
   std::span<SweepBundle> bundles;
   std::span<std::int32_t> overflow;
   std::span<std::uint64_t> body_colours;
+  std::span<double> bundle_change, bundle_direction, bundle_step;
   bool colours_given = false;  ///< overflow holds each manifold's colour (colour_manifolds); a solve overwrites them
 };
 
@@ -125,6 +127,7 @@ class SweepWork {
   std::vector<SweepRow> rows_;
   std::vector<double> change_, direction_, step_;
   std::vector<SweepBundle> bundles_;
+  std::vector<double> bundle_change_, bundle_direction_, bundle_step_;
   std::vector<std::int32_t> overflow_;
   std::vector<std::uint64_t> body_colours_;
 };

@@ -10,6 +10,8 @@
 namespace floedem {
 
 inline constexpr int kBundleLanes = 4;
+/// The NNCG values of a bundle (change, direction or step): per point, n then t, four lanes each.
+inline constexpr std::size_t kBundleNncg = 2 * 2 * kBundleLanes;
 
 /// One contact point of each of a bundle's manifolds, lane by lane: what the sweeps read and
 /// write ten times a step. The Delassus block and the local solve's reciprocals are made from

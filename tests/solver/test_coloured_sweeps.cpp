@@ -229,7 +229,7 @@ TEST_CASE("coloured sweeps: two-point manifolds placed first, the same impulses 
 
 TEST_CASE("coloured sweeps: each colour on the pool's threads, the same impulses to the bit", "[solver][coloured][threads]") {
   // 4 700 manifolds: colours of up to about 1 200 manifolds, 300 bundles, 5 blocks of 64: the
-  // largest go to the pool (4 blocks or more), the rest are swept on the calling thread; and
+  // largest go to the pool (4 blocks or more), their sweeps and NNCG steps alike, the rest on the calling thread; and
   // 4 096 manifolds or more are packed on the pool's threads, with the warm start on one of them.
   const bool accelerate = GENERATE(false, true);
   const Pack start = pack(60, 40, 21, true);
