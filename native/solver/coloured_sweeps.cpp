@@ -361,10 +361,14 @@ constexpr std::int32_t kEmptiesSecond = 1 << 30;       // in a slot: empty_secon
 // colours); then the lanes, blocks of manifolds on the pool's threads, while one of them
 // applies the warm start manifold by manifold in the given order (it writes only the bodies'
 // velocities, which the lanes do not read: the same velocities as the loop's, whatever the
-// threads).
+// threads). `place` keeps each bundle's point count in `points` (a byte a bundle, in cache:
+// written into each 768-byte bundle, it was a miss a manifold on this one thread, the largest
+// serial part of the 16k field's solve on two threads: perf), and the lane 0 of each bundle,
+// always taken, writes it into its bundle.
 template <class Place, class EmptiesSecond>
 void gather_on_threads(const Selection& m, BodyArrays& s, bool warm_start, const SweepSpace& space,
-                       const std::array<std::size_t, kColours>& first, Place&& place, EmptiesSecond&& empties_second) {
+                       const std::array<std::size_t, kColours>& first, Place&& place, EmptiesSecond&& empties_second,
+                       std::span<const std::uint8_t> points) {
   for (std::size_t i = 0; i < m.size(); ++i) {
     const std::int32_t written = space.overflow[i];
     const auto colour = static_cast<std::size_t>(colour_of(written));
@@ -386,8 +390,9 @@ void gather_on_threads(const Selection& m, BodyArrays& s, bool warm_start, const
     const std::size_t begin = (block - 1) * kPackingBlock, end = std::min(m.size(), begin + kPackingBlock);
     for (std::size_t i = begin; i < end; ++i) {
       const std::int32_t slot = space.overflow[i] & (kEmptiesSecond - 1);
-      pack_lane(space.bundles[static_cast<std::size_t>(slot / kBundleLanes)], slot % kBundleLanes, m[i], i, s,
-                (space.overflow[i] & kEmptiesSecond) != 0);
+      const auto bundle = static_cast<std::size_t>(slot / kBundleLanes);
+      pack_lane(space.bundles[bundle], slot % kBundleLanes, m[i], i, s, (space.overflow[i] & kEmptiesSecond) != 0);
+      if (slot % kBundleLanes == 0) space.bundles[bundle].points = points[bundle];
     }
   });
 }
@@ -430,21 +435,29 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
   auto empties_second = [&](std::size_t colour, std::size_t n) {
     return n - n % kBundleLanes < (two_points_first ? two[colour] : count[colour]);
   };
+  // A large solve swept on the threads (and nothing beyond the colours) is packed on them too.
+  const bool on_threads = threads && count[kColours] == 0 && m.size() >= kColouredOnThreads &&
+                          m.size() < kThreadedPackingMost && thread_pool().size() > 1;
+  thread_local std::vector<std::uint8_t> bundle_points;  // on threads: each bundle's point count (grown, never shrunk)
+  if (on_threads && bundle_points.size() < g.bundles) bundle_points.resize(g.bundles + g.bundles / 2);
   // The next place in its colour (n: bundle first[colour] + n / 4, lane n % 4) of a manifold of
   // `points` points, taken in the manifolds' order; its bundle's point count kept. Lane 0 resets
   // it. Where the two lists meet, lane 0 (two points) may be taken after a later lane (one
   // point): its count, 2, is the bundle's either way.
   auto place = [&](std::size_t colour, int points) {
     const std::size_t n = two_points_first && points == 2 ? next_two[colour]++ : next_one[colour]++;
-    SweepBundle& b = space.bundles[first[colour] + n / kBundleLanes];
+    const std::size_t j = first[colour] + n / kBundleLanes;
+    if (on_threads) {
+      if (n % kBundleLanes == 0) bundle_points[j] = 0;
+      bundle_points[j] = std::max(bundle_points[j], static_cast<std::uint8_t>(points));
+      return n;
+    }
+    SweepBundle& b = space.bundles[j];
     if (n % kBundleLanes == 0) b.points = 0;
     b.points = std::max(b.points, static_cast<std::int32_t>(points));
     return n;
   };
-  // A large solve swept on the threads (and nothing beyond the colours) is packed on them too.
-  const bool on_threads = threads && count[kColours] == 0 && m.size() >= kColouredOnThreads &&
-                          m.size() < kThreadedPackingMost && thread_pool().size() > 1;
-  if (on_threads) gather_on_threads(m, s, warm_start, space, first, place, empties_second);
+  if (on_threads) gather_on_threads(m, s, warm_start, space, first, place, empties_second, bundle_points);
   for (std::size_t i = 0; !on_threads && i < m.size(); ++i) {
     // What pack_lane reads of the manifold four on (its first 320 bytes; the colouring's
     // prefetch warmed only the first line). A prefetch changes no value.
@@ -479,15 +492,14 @@ Gathered gather_bundles(const Selection& m, BodyArrays& s, bool warm_start, bool
   return g;
 }
 
-// The impulses back into their manifolds' points.
-void scatter_bundles(const Selection& m, std::span<const SweepBundle> bundles, std::span<const SweepRow> rows,
-                     std::span<const std::int32_t> overflow) {
+// The impulses of the bundles [begin, end) back into their manifolds' points.
+void scatter_lanes(const Selection& m, std::span<const SweepBundle> bundles, std::size_t begin, std::size_t end) {
   // A bundle's manifolds are anywhere in the list (out of cache at 16k floes): the lines this
   // writes of those of the bundle two on are asked for ahead. A prefetch changes no value.
   constexpr std::size_t kAhead = 2;
-  for (std::size_t j = 0; j < bundles.size(); ++j) {
+  for (std::size_t j = begin; j < end; ++j) {
     const SweepBundle& b = bundles[j];
-    if (j + kAhead < bundles.size())
+    if (j + kAhead < end)
       for (const std::int32_t i : bundles[j + kAhead].manifold) {
         if (i < 0) continue;
         const Manifold& c = m[static_cast<std::size_t>(i)];
@@ -504,6 +516,18 @@ void scatter_bundles(const Selection& m, std::span<const SweepBundle> bundles, s
       }
     }
   }
+}
+
+// The impulses back into their manifolds' points; with `threads`, the bundles in blocks on the
+// pool's threads (each manifold is one lane's: the same stores on any number of threads).
+void scatter_bundles(const Selection& m, std::span<const SweepBundle> bundles, std::span<const SweepRow> rows,
+                     std::span<const std::int32_t> overflow, bool threads) {
+  constexpr std::size_t kScatterBlock = 512;  // bundles
+  if (threads)
+    thread_pool().for_blocks(bundles.size(), kScatterBlock,
+                             [&](std::size_t begin, std::size_t end) { scatter_lanes(m, bundles, begin, end); });
+  else
+    scatter_lanes(m, bundles, 0, bundles.size());
   std::size_t x = 0;
   for (const std::int32_t i : overflow) {
     Manifold& c = m[static_cast<std::size_t>(i)];
@@ -706,7 +730,7 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
                      threads);
     previous_size = r.size;
   }
-  scatter_bundles(m, bundles, rows, space.overflow.first(g.overflow));
+  scatter_bundles(m, bundles, rows, space.overflow.first(g.overflow), threads);
   return sweep;
 }
 
