@@ -16,7 +16,7 @@ struct NativeSettings {
   /// at a time, their colours on every thread), smaller ones in pair order: measured on the
   /// report's scenes (docs/architecture.md). `coloured_sweeps = true` in a scene sets it to 0
   /// (every island), `false` to never.
-  std::int64_t coloured_from = 16384;
+  std::int64_t coloured_from = 1024;
   int position_iterations = 4;       ///< position-projection sweeps per step (0: none)
   double position_correction = 0.2;  ///< fraction of the overlap removed per sweep
   double allowed_penetration = 1e-3; ///< m, overlap left alone (keeps contacts persistent)
