@@ -549,6 +549,18 @@ constexpr std::size_t kBlock = 64;  // bundles: 256 manifolds, about 5 us of a s
 // colours of about 100 bundles made its contact solve slower on two threads than on one).
 // Which thread sweeps a block changes no result, so neither does this bound.
 constexpr std::size_t kPoolBlocks = 4;
+
+// fn(begin, end) over the blocks of kBlock bundles of one colour of `count` bundles, in order on
+// this thread, or on the pool's threads with `threads` and kPoolBlocks blocks or more: the rule
+// the sweep and NNCG's step share.
+template <class F>
+void colour_blocks(std::size_t count, bool threads, F&& fn) {
+  if (threads && count >= kPoolBlocks * kBlock) {
+    thread_pool().for_blocks(count, kBlock, fn);
+    return;
+  }
+  for (std::size_t b = 0; b < count; b += kBlock) fn(b, std::min(count, b + kBlock));
+}
 SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, BodyArrays& s, double* change,
                           bool threads) {
   // A colour's blocks' results: the calling thread's list (grown, never shrunk), named by a
@@ -569,14 +581,9 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
     const std::span<SweepBundle> colour =
         bundles.subspan(g.colour_start[c], g.colour_start[c + 1] - g.colour_start[c]);
     if (colour.empty()) break;  // colours are taken lowest first: none after an empty one
-    if (!threads || colour.size() < kPoolBlocks * kBlock) {
-      for (std::size_t b = 0; b < colour.size(); b += kBlock)
-        add(sweep_once(colour.subspan(b, std::min(kBlock, colour.size() - b)), v, w, at(g.colour_start[c] + b)));
-      continue;
-    }
     const std::size_t count = (colour.size() + kBlock - 1) / kBlock;
     if (blocks.size() < count) blocks.resize(count + count / 2);  // no allocation per step once grown
-    thread_pool().for_blocks(colour.size(), kBlock, [&](std::size_t begin, std::size_t end) {
+    colour_blocks(colour.size(), threads, [&](std::size_t begin, std::size_t end) {
       blocks[begin / kBlock] = sweep_once(colour.subspan(begin, end - begin), v, w, at(g.colour_start[c] + begin));
     });
     for (std::size_t b = 0; b < count; ++b) add(blocks[b]);
@@ -661,15 +668,11 @@ void conjugate_step(std::span<SweepBundle> bundles, const Gathered& g, BodyArray
   for (int c = 0; c < kColours; ++c) {
     const std::size_t first = g.colour_start[c], count = g.colour_start[c + 1] - first;
     if (count == 0) break;  // colours are taken lowest first
-    auto run = [&](std::size_t begin, std::size_t end) {
+    colour_blocks(count, threads, [&](std::size_t begin, std::size_t end) {
       const std::size_t at = kBundleNncg * (first + begin);
       step_once(bundles.subspan(first + begin, end - begin), v, w, beta, direction.data() + at, change.data() + at,
                 step.data() + at);
-    };
-    if (!threads || count < kPoolBlocks * kBlock)
-      run(0, count);
-    else
-      thread_pool().for_blocks(count, kBlock, run);
+    });
   }
 }
 
