@@ -76,7 +76,7 @@ def write(ctx):
           "the timed window of the field packed on its wall. "
           "The per-body and per-pair loops (drag, forcing, placing, narrow phase, integration) and the contact "
           "solve's islands run on the pool, and the sweeps of an island large enough to be swept in colour order "
-          "(`engine.native.coloured_from` manifolds: the 16k and 10^5 fields', not the 4k field's) run on every "
+          "(`engine.native.coloured_from` manifolds, 1 024 by default: each packed field's one large island) run on every "
           "thread, colour by colour, and so do NNCG's steps between them, its packing into bundles and the "
           "impulses' return (`native/solver/coloured_sweeps.cpp`); an island swept in pair order with NNCG is one "
           "thread's. What stays on one thread bounds the speed-up: the position projection, the island grouping, "
