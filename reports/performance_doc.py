@@ -71,7 +71,6 @@ Each kept the results to the bit and did not pay on the report's machines:
 - prefetching only the bytes a one-point bundle reads, or only the manifold lines the projection and packing read;
 - bundles that read each lane's masses from the bodies' arrays instead of packing them;
 - a 32-byte velocity record per body of the coloured solve (the numbering and copies cost more than they saved);
-- transparent huge pages for the heap;
 - longer prefetch distances where the lists come from memory at 10^5 floes;
 - the coloured sweeps' AVX-512 build taking two bundles in one 8-lane vector (512-bit division throughput);
 - three or four bundles side by side instead of two;

@@ -5,6 +5,7 @@
 #include <span>
 #include <vector>
 
+#include "engine/line_vector.hpp"
 #include "solver/contact_types.hpp"
 #include "solver/native_settings.hpp"
 #include "solver/sweep_bundle.hpp"
@@ -124,10 +125,11 @@ class SweepWork {
   }
 
  private:
-  std::vector<SweepRow> rows_;
-  std::vector<double> change_, direction_, step_;
-  std::vector<SweepBundle> bundles_;
-  std::vector<double> bundle_change_, bundle_direction_, bundle_step_;
+  // Swept ten times a step and more: on huge pages once large (line_vector.hpp).
+  LineVector<SweepRow> rows_;
+  LineVector<double> change_, direction_, step_;
+  LineVector<SweepBundle> bundles_;
+  LineVector<double> bundle_change_, bundle_direction_, bundle_step_;
   std::vector<std::int32_t> overflow_;
   std::vector<std::uint64_t> body_colours_;
 };

@@ -1,5 +1,5 @@
 // LineVector (native/engine/line_vector.hpp): storage on a 64-byte cache line, through every way
-// the solver grows and swaps its lists, and the elements kept.
+// the solver grows and swaps its lists; large lists on whole 2 MiB pages; the elements kept.
 #include <catch2/catch.hpp>
 
 #include <cstdint>
@@ -53,4 +53,26 @@ TEST_CASE("line vector: growth keeps the elements, to the bit", "[engine][memory
   resize_with_headroom(v, 10000);
   for (int i = 0; i < 3000; ++i) REQUIRE(v[static_cast<std::size_t>(i)] == 0.1 * i + 1e-17 * i);
   for (std::size_t i = 3000; i < v.size(); ++i) REQUIRE(v[i] == 0.0);
+}
+
+TEST_CASE("line vector: a list of 2 MiB or more starts on a huge page, and keeps its elements", "[engine][memory]") {
+  const auto on_a_huge_page = [](const LineVector<double>& v) {
+    return reinterpret_cast<std::uintptr_t>(v.data()) % kHugePage == 0;
+  };
+  const std::size_t small = kHugePage / sizeof(double) / 2, large = 3 * kHugePage / sizeof(double) + 7;
+  LineVector<double> v(small);
+  REQUIRE(on_a_line(v));
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = 0.1 * static_cast<double>(i);
+  v.resize(large);  // across the threshold: the elements move onto huge pages
+  REQUIRE(on_a_huge_page(v));
+  for (std::size_t i = 0; i < small; ++i) REQUIRE(v[i] == 0.1 * static_cast<double>(i));
+  for (std::size_t i = small; i < large; ++i) REQUIRE(v[i] == 0.0);
+  v[large - 1] = 2.5;  // the last element, on the last page's partial end, is the list's own
+  LineVector<double> copy = v;
+  REQUIRE(on_a_huge_page(copy));
+  REQUIRE(copy[large - 1] == 2.5);
+  v.resize(small);
+  v.shrink_to_fit();  // and back below it: a cache line again, freed with the alignment it was made with
+  REQUIRE(on_a_line(v));
+  REQUIRE(v[small - 1] == 0.1 * static_cast<double>(small - 1));
 }
