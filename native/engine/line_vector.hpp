@@ -10,11 +10,11 @@
 // Huge pages: the coloured sweeps stream the packed field's bundles (768 bytes a bundle, about
 // 31 MB at 10^5 floes) ten times a step and more, and read and write the bodies between them.
 // On 4 KiB pages that is some 7 600 pages a sweep, more than a second-level TLB holds (2 048 to
-// 4 096 entries on recent x86-64), so the page walks come back every sweep; on 2 MiB pages, 16. A list of 2 MiB or more
-// is therefore placed on 2 MiB boundaries and marked for transparent huge pages
-// (madvise(MADV_HUGEPAGE)): Linux's default policy, "madvise", backs only marked memory with
-// huge pages. Where the policy is "never" or the call fails, the memory stays on small pages;
-// where it is "always", the mark changes nothing.
+// 4 096 entries on recent x86-64), so the page walks come back every sweep; on 2 MiB pages, 16.
+// A list of 2 MiB or more is therefore placed on 2 MiB boundaries and marked for transparent
+// huge pages (madvise(MADV_HUGEPAGE)): Linux's default policy, "madvise", backs only marked
+// memory with huge pages. Where the policy is "never" or the call fails, the memory stays on
+// small pages; where it is "always", the mark changes nothing.
 //
 // An allocation's address and page size change no value, so the results are the same to the bit.
 #include <cstddef>
@@ -40,7 +40,8 @@ struct LineAllocator {
   T* allocate(std::size_t n) {
     const std::size_t bytes = n * sizeof(T);
     if (bytes < kHugePage) return static_cast<T*>(::operator new(bytes, std::align_val_t{kCacheLine}));
-    const std::size_t whole = (bytes + kHugePage - 1) / kHugePage * kHugePage;  // whole pages: no neighbour on the last one
+    // Whole pages, so that no other allocation shares the last one.
+    const std::size_t whole = (bytes + kHugePage - 1) / kHugePage * kHugePage;
     void* p = ::operator new(whole, std::align_val_t{kHugePage});
     advise_huge_pages(p, whole);
     return static_cast<T*>(p);
