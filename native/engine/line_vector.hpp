@@ -37,18 +37,20 @@ struct LineAllocator {
   LineAllocator() = default;
   template <class U>
   constexpr LineAllocator(const LineAllocator<U>&) noexcept {}
+  /// One rule for both ends: a list of n elements is made, and freed, with this alignment.
+  static constexpr std::size_t alignment(std::size_t n) noexcept {
+    return n * sizeof(T) < kHugePage ? kCacheLine : kHugePage;
+  }
   T* allocate(std::size_t n) {
     const std::size_t bytes = n * sizeof(T);
-    if (bytes < kHugePage) return static_cast<T*>(::operator new(bytes, std::align_val_t{kCacheLine}));
+    if (alignment(n) == kCacheLine) return static_cast<T*>(::operator new(bytes, std::align_val_t{kCacheLine}));
     // Whole pages, so that no other allocation shares the last one.
     const std::size_t whole = (bytes + kHugePage - 1) / kHugePage * kHugePage;
     void* p = ::operator new(whole, std::align_val_t{kHugePage});
     advise_huge_pages(p, whole);
     return static_cast<T*>(p);
   }
-  void deallocate(T* p, std::size_t n) noexcept {
-    ::operator delete(p, std::align_val_t{n * sizeof(T) < kHugePage ? kCacheLine : kHugePage});
-  }
+  void deallocate(T* p, std::size_t n) noexcept { ::operator delete(p, std::align_val_t{alignment(n)}); }
   template <class U>
   bool operator==(const LineAllocator<U>&) const noexcept {
     return true;
