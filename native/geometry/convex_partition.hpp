@@ -9,8 +9,10 @@
 namespace floedem {
 
 /// Convex parts of a simple counter-clockwise polygon whose union is the polygon.
-/// Uses CGAL's optimal convex partition (Greene 1983; fewest parts) for up to 64 vertices,
-/// and the Hertel-Mehlhorn approximation (at most 4x the optimum) above that.
+/// Uses CGAL's optimal convex partition (Greene 1983; fewest parts) for up to 64 vertices in
+/// general position (no three on a line), and the Hertel-Mehlhorn approximation (at most 4x
+/// the optimum) otherwise or when the optimal answer fails its check. Every answer is checked
+/// (convex counter-clockwise parts that tile the polygon); none passing, the result is empty.
 /// A convex input is returned as its single part.
 std::vector<std::vector<Vec2>> convex_partition(std::span<const Vec2> ccw_polygon);
 
