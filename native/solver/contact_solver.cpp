@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "engine/prefetch.hpp"
+#include "parallel/thread_pool.hpp"
 #include "solver/coloured_sweeps.hpp"
 #include "solver/headroom.hpp"
 #include "solver/local_law.hpp"
@@ -370,27 +371,39 @@ double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const
       work.moved_bodies.push_back(body);  // its first move in this call
     work.moved[static_cast<std::size_t>(body)] = work.clock;
   };
+  // Point k's gap at the current poses, from the material points that made the contact: the
+  // reference face's normal n_ref and point, and the incident point q; gap = (q - face).n_ref.
+  struct PointGap {
+    Vec2 n_ref, q;
+    double gap;
+  };
+  auto point_gap = [&](const Manifold& m, int k) {
+    const int ref = m.reference_is_b ? m.body_b : m.body_a;
+    const int inc = m.reference_is_b ? m.body_a : m.body_b;
+    const Vec2 n_ref = s.rotation[ref].apply(m.local_normal);
+    const Vec2 face = s.position[ref] + s.rotation[ref].apply(m.local_face_point);
+    const Vec2 q = s.position[inc] + s.rotation[inc].apply(m.points[k].local_incident);
+    return PointGap{n_ref, q, dot(q - face, n_ref)};
+  };
+  // C = beta (gap + slop), clamped to [-max_correction, 0]: a point corrects where C < 0.
+  auto correction = [&](double gap) {
+    return std::clamp(settings.position_correction * (gap + settings.allowed_penetration), -settings.max_correction,
+                      0.0);
+  };
   // Measures manifold i's gaps and corrects them; returns its deepest gap.
   auto measure = [&](std::size_t i) {
     const Manifold& m = manifolds[i];
     const int a = m.body_a, b = m.body_b;
     work.evaluated[i] = ++work.clock;
     double depth = 0.0;
-    const int ref = m.reference_is_b ? b : a;
-    const int inc = m.reference_is_b ? a : b;
     const double ma = s.inv_mass[a], mb = s.inv_mass[b];
     const double ia = s.inv_inertia[a], ib = s.inv_inertia[b];
     for (int k = 0; k < m.point_count; ++k) {
-      // Current gap from the material points that made the contact.
-      const Vec2 n_ref = s.rotation[ref].apply(m.local_normal);
-      const Vec2 face = s.position[ref] + s.rotation[ref].apply(m.local_face_point);
-      const Vec2 q = s.position[inc] + s.rotation[inc].apply(m.points[k].local_incident);
-      const double gap = dot(q - face, n_ref);
+      const auto [n_ref, q, gap] = point_gap(m, k);
       depth = std::max(depth, -gap);
-      // C = beta (gap + slop), clamped to [-max_correction, 0]; solve K dlambda = -C with
-      // K = n.M^-1 n at the current configuration, and move positions only.
-      const double c = std::clamp(settings.position_correction * (gap + settings.allowed_penetration),
-                                  -settings.max_correction, 0.0);
+      // Solve K dlambda = -C with K = n.M^-1 n at the current configuration, and move
+      // positions only.
+      const double c = correction(gap);
       if (c >= 0.0) continue;
       const Vec2 n = m.reference_is_b ? -n_ref : n_ref;
       const Vec2 point = q - 0.5 * gap * n_ref;
@@ -407,18 +420,45 @@ double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const
     return depth;
   };
   if (settings.position_iterations <= 0) return 0.0;
-  // The first sweep: every manifold, its two bodies noted as it is read (for the lists below,
-  // which then need not read the manifolds again).
+  // The first sweep: every manifold. Its gaps are measured over the threads first, at the poses
+  // the sweep starts from, with each manifold's two bodies noted (for the lists below, which
+  // then need not read the manifolds again) and whether any point would correct. The sweep
+  // proper then goes in order and measures again only a manifold that corrects or whose bodies
+  // an earlier one moved; any other's gaps are those measured (same poses, same expressions,
+  // same bits), and it moves nothing. So the poses and depths are those of measuring every
+  // manifold in turn, on any thread count; in a settled field few manifolds correct, and the
+  // sweep's cost (reading every manifold and its bodies' poses) is shared by the threads.
   resize_with_headroom(work.ends, 2 * nm);
+  resize_with_headroom(work.corrects, nm);
+  thread_pool().for_blocks(nm, 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      // The manifold four on, every line of it asked for ahead: this pass reads the first line,
+      // each point's and the reference face's (the last), out of cache at 16k floes, and its
+      // hottest load waited on the last line (perf). A prefetch changes no value.
+      if (i + 4 < end) prefetch_lines(&manifolds[i + 4], sizeof(Manifold));
+      const Manifold& m = manifolds[i];
+      work.ends[2 * i] = m.body_a;
+      work.ends[2 * i + 1] = m.body_b;
+      double depth = 0.0;
+      bool corrects = false;
+      for (int k = 0; k < m.point_count; ++k) {
+        const double gap = point_gap(m, k).gap;
+        depth = std::max(depth, -gap);
+        corrects = corrects || correction(gap) < 0.0;
+      }
+      work.depth[i] = depth;
+      work.corrects[i] = corrects;
+    }
+  });
   double deepest = 0.0;
   for (std::size_t i = 0; i < nm; ++i) {
-    // The manifold four on, every line of it asked for ahead: this sweep reads the first line,
-    // each point's and the reference face's (the last), out of cache at 16k floes, and its
-    // hottest load waited on the last line (perf). A prefetch changes no value.
-    if (i + 4 < nm) prefetch_lines(&manifolds[i + 4], sizeof(Manifold));
-    work.ends[2 * i] = manifolds[i].body_a;
-    work.ends[2 * i + 1] = manifolds[i].body_b;
-    deepest = std::max(deepest, measure(i));
+    const auto a = static_cast<std::size_t>(work.ends[2 * i]), b = static_cast<std::size_t>(work.ends[2 * i + 1]);
+    if (work.corrects[i] || work.moved[a] > start || work.moved[b] > start) {
+      deepest = std::max(deepest, measure(i));
+    } else {
+      work.evaluated[i] = ++work.clock;  // as measure() would stamp it
+      deepest = std::max(deepest, work.depth[i]);
+    }
   }
   if (settings.position_iterations == 1 || deepest <= 1.5 * settings.allowed_penetration) return deepest;
 

@@ -193,6 +193,7 @@ struct ProjectionWork {
   std::vector<std::int32_t> body_manifolds;  ///< ... body_first[b + 1])
   std::vector<std::int32_t> moved_bodies;  ///< the bodies the first sweep moved (each once)
   std::vector<std::int32_t> ends;          ///< per manifold, its two bodies (taken by the first sweep)
+  std::vector<std::uint8_t> corrects;      ///< per manifold: a point corrects at the first sweep's start poses
 };
 
 /// Nonlinear Gauss-Seidel on positions (Box2D v2.4's position solver): pushes overlapping
