@@ -77,6 +77,7 @@ Each kept the results to the bit and did not pay on the report's machines:
 - level scheduling of the sweeps over threads (each level's hand-over cost as much as its work);
 - a branch-free local solve in the plain sweeps (the branches were not the cost);
 - a compact warm-start record read by the contact list (the cost moved to the recorder);
+- the contact records written over the threads in two passes, count then write (the second read of the manifolds cost one thread more than two threads saved);
 - link-time optimisation (within the noise, for a longer build).
 
 ## Measured outside the report
