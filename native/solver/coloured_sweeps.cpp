@@ -99,17 +99,58 @@ FLOEDEM_LANES BundleRun start(const SweepBundle& b, const Vec2* v, const double*
   return {gather(b.body_a, v, w), gather(b.body_b, v, w), load(b.nx), load(b.ny), load(b.friction)};
 }
 
+// NNCG's step as the sweep after the one that called for it takes it (solve_coloured says why):
+// `start`, p = r (the first step, beta = 0); `step`, the impulses P += beta p, then
+// p = beta p + r; `restart`, p = 0 (the merit rose). r is the last sweep's change.
+struct PendingStep {
+  enum class Kind { none, start, step, restart } kind = Kind::none;
+  double beta = 0.0;
+};
+
+// The pending step at one point of a bundle (`change` and `direction` its n then t values, four
+// lanes each): the step's impulse added to pn and pt, the point's impulses before its solve.
+FLOEDEM_LANES void take_step(const PendingStep& pending, const double* change, double* direction, v4d& pn, v4d& pt) {
+  switch (pending.kind) {
+    case PendingStep::Kind::none: return;
+    case PendingStep::Kind::start:
+      store(direction, load(change));
+      store(direction + kBundleLanes, load(change + kBundleLanes));
+      return;
+    case PendingStep::Kind::restart:
+      store(direction, splat(0.0));
+      store(direction + kBundleLanes, splat(0.0));
+      return;
+    case PendingStep::Kind::step: {
+      const v4d beta = splat(pending.beta);
+      const v4d xn = beta * load(direction), xt = beta * load(direction + kBundleLanes);
+      store(direction, xn + load(change));
+      store(direction + kBundleLanes, xt + load(change + kBundleLanes));
+      pn = pn + xn;
+      pt = pt + xt;
+      return;
+    }
+  }
+}
+
+// NNCG's values of the bundle under way: kBundleNncg each (point, n or t, lane); null without NNCG.
+struct BundleNncg {
+  double* change = nullptr;
+  double* direction = nullptr;
+};
+
 // Point k of a bundle: its local solve and impulse. Returns |dP|^2 per lane (NNCG's merit: the
-// caller adds it in point order); with `change` (NNCG: the bundle's kBundleNncg values), the
-// lanes' impulse changes into it, n then t (an empty lane's is zero).
+// caller adds it in point order); with NNCG, the pending step taken first and the lanes' impulse
+// changes into `change`, n then t (an empty lane's is zero).
 FLOEDEM_LANES v4d sweep_point(SweepBundle& b, int k, BundleRun& r, v4d& largest_change, v4d& largest_impulse,
-                              double* change) {
+                              const BundleNncg& nncg, const PendingStep& pending) {
   BundlePoint& p = b.point[k];
   const v4d nx = r.nx, ny = r.ny;
   // Relative velocity of b's point with respect to a's: (v_b + w_b k x r_b) - (v_a + w_a k x r_a).
   const v4d ux = (r.b_side.vx + -r.b_side.w * load(p.rby)) - (r.a_side.vx + -r.a_side.w * load(p.ray));
   const v4d uy = (r.b_side.vy + r.b_side.w * load(p.rbx)) - (r.a_side.vy + r.a_side.w * load(p.rax));
-  const v4d pn0 = load(p.normal_impulse), pt0 = load(p.tangent_impulse);
+  v4d pn0 = load(p.normal_impulse), pt0 = load(p.tangent_impulse);
+  double* const change = nncg.change == nullptr ? nullptr : nncg.change + 2 * kBundleLanes * k;
+  if (change != nullptr) take_step(pending, change, nncg.direction + 2 * kBundleLanes * k, pn0, pt0);
   // Velocity without this point's own impulse.
   const Delassus d = delassus(b, p, nx, ny);
   const v4d ufn = (ux * nx + uy * ny) - (d.wnn * pn0 + d.wnt * pt0);
@@ -123,8 +164,8 @@ FLOEDEM_LANES v4d sweep_point(SweepBundle& b, int k, BundleRun& r, v4d& largest_
   largest_change = max(largest_change, abs(dpn) + abs(dpt));
   largest_impulse = max(largest_impulse, pn + abs(pt));
   if (change == nullptr) return splat(0.0);
-  store(change + 2 * kBundleLanes * k, dpn);
-  store(change + 2 * kBundleLanes * k + kBundleLanes, dpt);
+  store(change, dpn);
+  store(change + kBundleLanes, dpt);
   return dpn * dpn + dpt * dpt;
 }
 
@@ -133,8 +174,9 @@ FLOEDEM_LANES void finish(const SweepBundle& b, const BundleRun& r, Vec2* v, dou
   scatter(b.body_b, b.mb, r.b_side, v, w);
 }
 
-// One Gauss-Seidel sweep over the bundles, in order; with `change` (NNCG), each point's
-// impulse change into it (kBundleNncg values a bundle, in the bundles' order). The bundles are one colour's:
+// One Gauss-Seidel sweep over the bundles, in order; with NNCG (`nncg` the first bundle's values,
+// kBundleNncg a bundle in the bundles' order), each point's pending step taken and its impulse
+// change stored. The bundles are one colour's:
 // no two share a moving body, so the order in which their points are solved does not change
 // what any computes. Two are solved side by side, point k of one beside point k of the other:
 // each bundle's points are one chain of dependent operations (its bodies' velocities), over
@@ -149,25 +191,29 @@ FLOEDEM_LANES void finish(const SweepBundle& b, const BundleRun& r, Vec2* v, dou
 // changes no value; in cache it costs a little.
 constexpr std::size_t kSweepAhead = 4;
 
-FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
+FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, const BundleNncg& nncg,
+                                      const PendingStep& pending) {
   v4d largest_change = splat(0.0), largest_impulse = splat(0.0), size = splat(0.0);
+  const bool accelerate = nncg.change != nullptr;
+  auto values = [&](std::size_t j) {
+    return accelerate ? BundleNncg{nncg.change + kBundleNncg * j, nncg.direction + kBundleNncg * j} : BundleNncg{};
+  };
   std::size_t i = 0;
   for (; i + 1 < bundles.size(); i += 2) {
     SweepBundle &b0 = bundles[i], &b1 = bundles[i + 1];
     // Near the span's end: the colour's next block, or past the array (never faults).
     prefetch_record(bundles.data(), i + kSweepAhead, 2 * sizeof(SweepBundle));
     BundleRun r0 = start(b0, v, w), r1 = start(b1, v, w);
-    double* const c0 = change == nullptr ? nullptr : change + kBundleNncg * i;
-    double* const c1 = change == nullptr ? nullptr : c0 + kBundleNncg;
+    const BundleNncg c0 = values(i), c1 = values(i + 1);
     v4d sq0[2], sq1[2];
     const int both = std::min(b0.points, b1.points);
     for (int k = 0; k < both; ++k) {
-      sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, c0);
-      sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, c1);
+      sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, c0, pending);
+      sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, c1, pending);
     }
-    for (int k = both; k < b0.points; ++k) sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, c0);
-    for (int k = both; k < b1.points; ++k) sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, c1);
-    if (change != nullptr) {
+    for (int k = both; k < b0.points; ++k) sq0[k] = sweep_point(b0, k, r0, largest_change, largest_impulse, c0, pending);
+    for (int k = both; k < b1.points; ++k) sq1[k] = sweep_point(b1, k, r1, largest_change, largest_impulse, c1, pending);
+    if (accelerate) {
       for (int k = 0; k < b0.points; ++k) size = size + sq0[k];
       for (int k = 0; k < b1.points; ++k) size = size + sq1[k];
     }
@@ -177,10 +223,10 @@ FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, d
   if (i < bundles.size()) {
     SweepBundle& b = bundles[i];
     BundleRun r = start(b, v, w);
-    double* const c = change == nullptr ? nullptr : change + kBundleNncg * i;
+    const BundleNncg c = values(i);
     for (int k = 0; k < b.points; ++k) {
-      const v4d sq = sweep_point(b, k, r, largest_change, largest_impulse, c);
-      if (change != nullptr) size = size + sq;
+      const v4d sq = sweep_point(b, k, r, largest_change, largest_impulse, c, pending);
+      if (accelerate) size = size + sq;
     }
     finish(b, r, v, w);
   }
@@ -196,28 +242,31 @@ FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, d
 // The sweep built three times: for the x86-64 baseline, for AVX2 and for AVX-512, the fastest
 // the processor runs picked at run time. The same operations on each lane in each (no fused
 // multiply-add: -ffp-contract=off), so the same impulses to the bit (tested).
-SweepResult sweep_baseline(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
-  return sweep_lanes(bundles, v, w, change);
+SweepResult sweep_baseline(std::span<SweepBundle> bundles, Vec2* v, double* w, const BundleNncg& nncg,
+                           const PendingStep& pending) {
+  return sweep_lanes(bundles, v, w, nncg, pending);
 }
 #if defined(__x86_64__)
 #define FLOEDEM_HAS_AVX2_SWEEP 1
-[[gnu::target("avx2")]] SweepResult sweep_avx2(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
-  return sweep_lanes(bundles, v, w, change);
+[[gnu::target("avx2")]] SweepResult sweep_avx2(std::span<SweepBundle> bundles, Vec2* v, double* w,
+                                               const BundleNncg& nncg, const PendingStep& pending) {
+  return sweep_lanes(bundles, v, w, nncg, pending);
 }
 // AVX-512's 32 vector registers (for the same 4-lane vectors) spare the AVX2 build's spills.
 [[gnu::target("avx2,avx512f,avx512vl")]] SweepResult sweep_avx512(std::span<SweepBundle> bundles, Vec2* v, double* w,
-                                                                  double* change) {
-  return sweep_lanes(bundles, v, w, change);
+                                                                  const BundleNncg& nncg, const PendingStep& pending) {
+  return sweep_lanes(bundles, v, w, nncg, pending);
 }
 #endif
 
-SweepResult sweep_once(std::span<SweepBundle> bundles, Vec2* v, double* w, double* change) {
+SweepResult sweep_once(std::span<SweepBundle> bundles, Vec2* v, double* w, const BundleNncg& nncg,
+                       const PendingStep& pending) {
   switch (lane_isa()) {
 #ifdef FLOEDEM_HAS_AVX2_SWEEP
-    case LaneIsa::avx512: return sweep_avx512(bundles, v, w, change);
-    case LaneIsa::avx2: return sweep_avx2(bundles, v, w, change);
+    case LaneIsa::avx512: return sweep_avx512(bundles, v, w, nncg, pending);
+    case LaneIsa::avx2: return sweep_avx2(bundles, v, w, nncg, pending);
 #endif
-    default: return sweep_baseline(bundles, v, w, change);
+    default: return sweep_baseline(bundles, v, w, nncg, pending);
   }
 }
 
@@ -561,8 +610,8 @@ void colour_blocks(std::size_t count, bool threads, F&& fn) {
   }
   for (std::size_t b = 0; b < count; b += kBlock) fn(b, std::min(count, b + kBlock));
 }
-SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, BodyArrays& s, double* change,
-                          bool threads) {
+SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, BodyArrays& s, const BundleNncg& nncg,
+                          const PendingStep& pending, bool threads) {
   // A colour's blocks' results: the calling thread's list (grown, never shrunk), named by a
   // reference for the workers (a thread_local named inside their lambda would be their own).
   thread_local std::vector<SweepResult> caller_blocks;
@@ -571,7 +620,11 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
   double* const w = s.angular_velocity.data();
   SweepResult total;
   // The NNCG values of the bundle `first` (of the solve's) on.
-  auto at = [&](std::size_t first) { return change == nullptr ? nullptr : change + kBundleNncg * first; };
+  auto at = [&](std::size_t first) {
+    return nncg.change == nullptr
+               ? BundleNncg{}
+               : BundleNncg{nncg.change + kBundleNncg * first, nncg.direction + kBundleNncg * first};
+  };
   auto add = [&](const SweepResult& r) {
     total.largest_change = std::max(total.largest_change, r.largest_change);
     total.largest_impulse = std::max(total.largest_impulse, r.largest_impulse);
@@ -584,96 +637,113 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
     const std::size_t count = (colour.size() + kBlock - 1) / kBlock;
     if (blocks.size() < count) blocks.resize(count + count / 2);  // no allocation per step once grown
     colour_blocks(colour.size(), threads, [&](std::size_t begin, std::size_t end) {
-      blocks[begin / kBlock] = sweep_once(colour.subspan(begin, end - begin), v, w, at(g.colour_start[c] + begin));
+      blocks[begin / kBlock] =
+          sweep_once(colour.subspan(begin, end - begin), v, w, at(g.colour_start[c] + begin), pending);
     });
     for (std::size_t b = 0; b < count; ++b) add(blocks[b]);
   }
   return total;
 }
 
-// The NNCG step beta p (contact_solver.cpp, run_sweeps) over a run of bundles, in order: each
-// bundle's values step = beta p and p = step + r (run_sweeps' dense loop, the same operation on
-// each value), then its step applied where any lane's is not zero (a bundle whose points neither
-// moved nor carry a direction costs no look at its bodies). The rows beyond the colours take no
-// step: their changes are not recorded, so their direction stays zero (they are swept plainly;
-// only a body with more than 63 contacts has them). A value past a bundle's points, or of an
-// empty lane, is zero from the solve's start and stays so.
-FLOEDEM_LANES void step_lanes(std::span<SweepBundle> bundles, Vec2* v, double* w, double beta, double* direction,
-                              const double* change, double* step) {
-  const v4d scale = splat(beta);
-  for (std::size_t j = 0; j < bundles.size(); ++j) {
-    double* const p = direction + kBundleNncg * j;
-    const double* const r = change + kBundleNncg * j;
-    double* const x = step + kBundleNncg * j;
-    v4m moves{};
-    for (std::size_t q = 0; q < kBundleNncg; q += kBundleLanes) {
-      const v4d stepped = scale * load(p + q);
-      store(x + q, stepped);
-      store(p + q, stepped + load(r + q));
-      moves = moves | (v4m)(stepped != 0.0);
+// NNCG's step per body. The step beta p moves each body's velocity by beta M^-1 J^T p, and
+// M^-1 J^T p obeys the direction's own update: with p <- beta p + r, it becomes
+// beta M^-1 J^T p + M^-1 J^T r, and M^-1 J^T r, the velocity the last sweep's changes r
+// carried, is what that sweep did to the body: its velocity after the colours less its
+// velocity before. So each moving body keeps v0 (its velocity as the sweep began) and
+// dv = M^-1 J^T p (BodyStep), and the step is one pass over the bodies; each bundle's share
+// (P += beta p, p <- beta p + r) is taken by the next sweep as it reaches the bundle, before its
+// points' solves (take_step): the same order as a step made apart after the sweep. A step
+// made apart reads and writes every bundle once more each sweep, and its values twice: at 100k
+// floes, where the bundles come from memory, half as much traffic again as the sweep (perf).
+// The velocities differ from a step made point by point only by rounding (a difference of
+// velocities instead of a sum of increments, some 1e-16 of a speed a sweep).
+
+// The solve's moving bodies (listed once each, in the bundles' order, marked meanwhile with
+// body_colours' bit above the colours), each one's v0 its velocity now and its dv zero.
+constexpr std::uint64_t kListed = std::uint64_t{1} << kColours;
+std::span<const std::int32_t> list_moving_bodies(std::span<const SweepBundle> bundles, const BodyArrays& s,
+                                                 const SweepSpace& space) {
+  std::size_t n = 0;
+  auto list = [&](std::int32_t body) {
+    std::uint64_t& mark = space.body_colours[static_cast<std::size_t>(body)];
+    if (s.inv_mass[body] == 0.0 || (mark & kListed) != 0) return;
+    mark |= kListed;
+    space.moving_bodies[n++] = body;
+    space.body_steps[static_cast<std::size_t>(body)] = {s.velocity[body], s.angular_velocity[body], {}, 0.0};
+  };
+  for (const SweepBundle& b : bundles)
+    for (int l = 0; l < kBundleLanes; ++l) {
+      if (b.manifold[l] < 0) continue;
+      list(b.body_a[l]);
+      list(b.body_b[l]);
     }
-    if ((moves[0] | moves[1] | moves[2] | moves[3]) == 0) continue;
-    SweepBundle& b = bundles[j];
-    Side a_side = gather(b.body_a, v, w), b_side = gather(b.body_b, v, w);
-    const v4d nx = load(b.nx), ny = load(b.ny);
-    for (int k = 0; k < b.points; ++k) {
-      BundlePoint& pt = b.point[k];
-      const v4d n_step = load(x + 2 * kBundleLanes * k), t_step = load(x + 2 * kBundleLanes * k + kBundleLanes);
-      apply(b, pt, n_step * nx + t_step * -ny, n_step * ny + t_step * nx, a_side, b_side);
-      store(pt.normal_impulse, load(pt.normal_impulse) + n_step);
-      store(pt.tangent_impulse, load(pt.tangent_impulse) + t_step);
+  for (std::size_t i = 0; i < n; ++i) space.body_colours[static_cast<std::size_t>(space.moving_bodies[i])] = 0;
+  return space.moving_bodies.first(n);
+}
+
+// fn(begin, end) over the moving bodies, in blocks on the pool's threads with `threads` (each
+// body's values are its own: the same on any number of threads).
+template <class F>
+void body_blocks(std::size_t count, bool threads, F&& fn) {
+  constexpr std::size_t kBodyBlock = 4096;
+  if (threads && count >= 2 * kBodyBlock) {
+    thread_pool().for_blocks(count, kBodyBlock, fn);
+    return;
+  }
+  fn(std::size_t{0}, count);
+}
+
+// What the colours' sweep did to each moving body's velocity, into its v0 (the rows beyond the
+// colours are swept next, and take no step: what they do is not the direction's).
+void measure_sweep(std::span<const std::int32_t> moving, const BodyArrays& s, std::span<BodyStep> steps,
+                   bool threads) {
+  body_blocks(moving.size(), threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::int32_t b = moving[i];
+      BodyStep& d = steps[static_cast<std::size_t>(b)];
+      d.v0 = s.velocity[b] - d.v0;
+      d.w0 = s.angular_velocity[b] - d.w0;
     }
-    scatter(b.body_a, b.ma, a_side, v, w);
-    scatter(b.body_b, b.mb, b_side, v, w);
-  }
+  });
 }
 
-// Built for each instruction set as the sweep is (the same values to the bit).
-void step_baseline(std::span<SweepBundle> bundles, Vec2* v, double* w, double beta, double* direction,
-                   const double* change, double* step) {
-  step_lanes(bundles, v, w, beta, direction, change, step);
-}
-#ifdef FLOEDEM_HAS_AVX2_SWEEP
-[[gnu::target("avx2")]] void step_avx2(std::span<SweepBundle> bundles, Vec2* v, double* w, double beta,
-                                       double* direction, const double* change, double* step) {
-  step_lanes(bundles, v, w, beta, direction, change, step);
-}
-[[gnu::target("avx2,avx512f,avx512vl")]] void step_avx512(std::span<SweepBundle> bundles, Vec2* v, double* w,
-                                                          double beta, double* direction, const double* change,
-                                                          double* step) {
-  step_lanes(bundles, v, w, beta, direction, change, step);
-}
-#endif
-
-void step_once(std::span<SweepBundle> bundles, Vec2* v, double* w, double beta, double* direction,
-               const double* change, double* step) {
-  switch (lane_isa()) {
-#ifdef FLOEDEM_HAS_AVX2_SWEEP
-    case LaneIsa::avx512: return step_avx512(bundles, v, w, beta, direction, change, step);
-    case LaneIsa::avx2: return step_avx2(bundles, v, w, beta, direction, change, step);
-#endif
-    default: return step_baseline(bundles, v, w, beta, direction, change, step);
-  }
-}
-
-// The step over every bundle, colour by colour, a large colour's blocks on the pool's threads
-// as the sweep's: bundles of one colour share no moving body, and the pool returns before the
-// next colour, so each body's velocity takes its steps in the order one thread gives them (the
-// same step to the bit on any number of threads).
-void conjugate_step(std::span<SweepBundle> bundles, const Gathered& g, BodyArrays& s, double beta,
-                    std::span<double> direction, std::span<const double> change, std::span<double> step,
-                    bool threads) {
-  Vec2* const v = s.velocity.data();
-  double* const w = s.angular_velocity.data();
-  for (int c = 0; c < kColours; ++c) {
-    const std::size_t first = g.colour_start[c], count = g.colour_start[c + 1] - first;
-    if (count == 0) break;  // colours are taken lowest first
-    colour_blocks(count, threads, [&](std::size_t begin, std::size_t end) {
-      const std::size_t at = kBundleNncg * (first + begin);
-      step_once(bundles.subspan(first + begin, end - begin), v, w, beta, direction.data() + at, change.data() + at,
-                step.data() + at);
-    });
-  }
+// The pending step's share on the bodies, before the sweep that takes the bundles' share: with
+// `measured`, the last sweep's change is in v0 already (measure_sweep). Each body's v0 is then
+// its velocity as the next sweep begins.
+void step_bodies(std::span<const std::int32_t> moving, BodyArrays& s, std::span<BodyStep> steps,
+                 const PendingStep& pending, bool measured, bool threads) {
+  body_blocks(moving.size(), threads, [&](std::size_t begin, std::size_t end) {
+    const double beta = pending.beta;
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::int32_t b = moving[i];
+      BodyStep& d = steps[static_cast<std::size_t>(b)];
+      Vec2 v = s.velocity[b];
+      double w = s.angular_velocity[b];
+      const Vec2 rv = measured ? d.v0 : v - d.v0;  // M^-1 J^T r
+      const double rw = measured ? d.w0 : w - d.w0;
+      switch (pending.kind) {
+        case PendingStep::Kind::none: break;
+        case PendingStep::Kind::start:
+          d.dv = rv;
+          d.dw = rw;
+          break;
+        case PendingStep::Kind::restart:
+          d.dv = {};
+          d.dw = 0.0;
+          break;
+        case PendingStep::Kind::step:
+          v = v + beta * d.dv;
+          w = w + beta * d.dw;
+          d.dv = beta * d.dv + rv;
+          d.dw = beta * d.dw + rw;
+          s.velocity[b] = v;
+          s.angular_velocity[b] = w;
+          break;
+      }
+      d.v0 = v;
+      d.w0 = w;
+    }
+  });
 }
 
 }  // namespace
@@ -695,25 +765,32 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
   const Gathered g = gather_bundles(m, s, warm_start, /*two_points_first=*/!accelerate && !given_order, space, threads);
   const std::span<SweepBundle> bundles = space.bundles.first(g.bundles);
   const std::span<SweepRow> rows = space.rows.first(g.rows);
-  std::span<double> change, direction, step;
+  std::span<double> change, direction;
+  std::span<const std::int32_t> moving;
   if (accelerate) {
     const std::size_t values = kBundleNncg * g.bundles;
     if (space.bundle_change.size() < values || space.bundle_direction.size() < values ||
-        space.bundle_step.size() < values)
+        space.moving_bodies.size() < 2 * m.size() || space.body_steps.size() < s.inv_mass.size())
       throw std::logic_error("solve_velocities: the sweep space has no room for the coloured NNCG values");
+    // Each is written before it is read: r by the first sweep, p by the first step (start).
     change = space.bundle_change.first(values);
     direction = space.bundle_direction.first(values);
-    step = space.bundle_step.first(values);
-    std::fill(change.begin(), change.end(), 0.0);
-    std::fill(direction.begin(), direction.end(), 0.0);
+    moving = list_moving_bodies(bundles, s, space);
   }
-  // run_sweeps' loop (contact_solver.cpp), over the bundles and then the rows beyond the colours.
+  const BundleNncg nncg = accelerate ? BundleNncg{change.data(), direction.data()} : BundleNncg{};
+  // run_sweeps' loop (contact_solver.cpp), over the bundles and then the rows beyond the colours,
+  // NNCG's step made by the sweep after the one that calls for it (step_bodies' comment).
   double previous_size = 0.0;
   int max_iterations = limits.iterations;
   int sweep = 0;
+  PendingStep pending;
   while (sweep < max_iterations) {
     ++sweep;
-    SweepResult r = sweep_colours(bundles, g, s, accelerate ? change.data() : nullptr, threads);
+    if (pending.kind != PendingStep::Kind::none)
+      step_bodies(moving, s, space.body_steps, pending, /*measured=*/!rows.empty(), threads);
+    SweepResult r = sweep_colours(bundles, g, s, nncg, pending, threads);
+    pending = {};
+    if (accelerate && !rows.empty()) measure_sweep(moving, s, space.body_steps, threads);
     for (SweepRow& row : rows) {
       const RowChange d = sweep_row(row, s);
       r.largest_change = std::max(r.largest_change, std::abs(d.normal) + std::abs(d.tangent));
@@ -727,10 +804,11 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
     }
     if (!accelerate || sweep == max_iterations) continue;
     if (previous_size > 0.0 && r.size > previous_size)
-      std::fill(direction.begin(), direction.end(), 0.0);  // the merit rose: restart
+      pending.kind = PendingStep::Kind::restart;  // the merit rose: restart
+    else if (previous_size > 0.0)
+      pending = {PendingStep::Kind::step, r.size / previous_size};
     else
-      conjugate_step(bundles, g, s, previous_size > 0.0 ? r.size / previous_size : 0.0, direction, change, step,
-                     threads);
+      pending.kind = PendingStep::Kind::start;
     previous_size = r.size;
   }
   scatter_bundles(m, bundles, rows, space.overflow.first(g.overflow), threads);

@@ -1,6 +1,7 @@
 #pragma once
-// Gauss-Seidel sweeps in colour order, four manifolds side by side (the native engine's
-// `coloured_sweeps`; contact_solver.cpp keeps the sweeps in pair order, the default).
+// Gauss-Seidel sweeps in colour order, four manifolds side by side: the order the native engine
+// gives an island of `coloured_from` manifolds or more (contact_solver.cpp sweeps smaller ones
+// in pair order; docs/architecture.md says why both are kept).
 //
 // The sweeps in pair order update point after point, each reading the velocities the one before
 // it wrote. A pair list sorted by part puts a floe's contacts one after another, so each update
@@ -19,7 +20,7 @@
 // It is another Gauss-Seidel order of the same points with the same local law (local_law.hpp,
 // the pair order's, lane by lane: the same bits for the same inputs), so it converges to the
 // same solution; after a given number of sweeps its impulses differ from the pair order's (a
-// setting, not an optimisation of the default: results are not the pair order's to the bit).
+// different order, not a faster way to the pair order's bits).
 // Each lane's arithmetic is IEEE double, no fused multiply-add (CMakeLists), so the result is
 // the same on any x86-64, with or without AVX2 or AVX-512, and on any number of threads (a
 // large island's colours are swept in fixed blocks on the pool's threads). docs/performance.md
@@ -41,7 +42,7 @@ constexpr std::size_t kColouredOnThreads = 4096;
 /// The coloured solve of the manifolds `island` (indices into `manifolds`, in order; empty: all
 /// of them): solve_velocities with SweepOptions::colour. `space` needs bundles and slots for
 /// the manifolds, the scene's body_colours (all zero, and left so) and, with `accelerate`,
-/// bundle_change/direction/step (SweepWork::reserve with colour_bodies).
+/// bundle_change/direction, moving_bodies and body_steps (SweepWork::reserve with colour_bodies).
 /// With `threads`, each colour's bundles are swept on the pool's threads (not from inside a
 /// loop of the pool), and a solve of 4 096 manifolds or more is packed into its bundles there
 /// too: the same impulses to the bit as without. Without `accelerate`, each

@@ -269,7 +269,8 @@ void SweepWork::reserve(std::size_t manifolds, bool accelerate, std::size_t colo
     if (accelerate) {
       grow(bundle_change_, kBundleNncg * bundles);
       grow(bundle_direction_, kBundleNncg * bundles);
-      grow(bundle_step_, kBundleNncg * bundles);
+      grow(moving_bodies_, 2 * manifolds);
+      if (body_steps_.size() < colour_bodies) body_steps_.resize(colour_bodies);
     }
     grow(overflow_, manifolds);
     if (body_colours_.size() < colour_bodies) body_colours_.resize(colour_bodies, 0);  // zero, and kept zero by each solve
@@ -290,7 +291,8 @@ SweepSpace SweepWork::slice(std::size_t first, std::size_t count, std::size_t bu
           std::span<std::uint64_t>(body_colours_),
           part(bundle_change_, kBundleNncg * bundle_first, kBundleNncg * bundle_count),
           part(bundle_direction_, kBundleNncg * bundle_first, kBundleNncg * bundle_count),
-          part(bundle_step_, kBundleNncg * bundle_first, kBundleNncg * bundle_count)};
+          part(moving_bodies_, 2 * first, 2 * count),
+          std::span<BodyStep>(body_steps_)};
 }
 
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepSpace space,

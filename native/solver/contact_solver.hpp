@@ -98,11 +98,15 @@ struct SweepSpace {
   /// id) the colours its manifolds took so far, all zero between solves: islands share no
   /// moving body, so islands solved side by side write disjoint entries of it. Its NNCG arrays
   /// are per bundle (kBundleNncg doubles: point, n or t, lane), in the bundles' order, so that
-  /// the sweep stores a bundle's changes as two vectors and the step reads them in order.
+  /// the sweep reads and stores a bundle's values as vectors; per manifold, room for the list
+  /// of the solve's moving bodies (two each at most); and per body (the scene's, by body id,
+  /// shared as body_colours) the velocities NNCG's step works on.
   std::span<SweepBundle> bundles;
   std::span<std::int32_t> overflow;
   std::span<std::uint64_t> body_colours;
-  std::span<double> bundle_change, bundle_direction, bundle_step;
+  std::span<double> bundle_change, bundle_direction;
+  std::span<std::int32_t> moving_bodies;
+  std::span<BodyStep> body_steps;
   bool colours_given = false;  ///< overflow holds each manifold's colour (colour_manifolds); a solve overwrites them
 };
 
@@ -129,9 +133,10 @@ class SweepWork {
   LineVector<SweepRow> rows_;
   LineVector<double> change_, direction_, step_;
   LineVector<SweepBundle> bundles_;
-  LineVector<double> bundle_change_, bundle_direction_, bundle_step_;
-  std::vector<std::int32_t> overflow_;
+  LineVector<double> bundle_change_, bundle_direction_;
+  std::vector<std::int32_t> overflow_, moving_bodies_;
   std::vector<std::uint64_t> body_colours_;
+  std::vector<BodyStep> body_steps_;
 };
 
 /// How long the sweeps go on.

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "engine/cache_line.hpp"
+#include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
 
@@ -35,6 +36,16 @@ struct alignas(kCacheLine) SweepBundle {
   BundlePoint point[2];
 };
 static_assert(sizeof(SweepBundle) == 768);
+
+/// NNCG's values of one moving body of a coloured solve: its velocity when the last sweep
+/// began, and the velocity that the conjugate direction p carries (M^-1 J^T p: the step beta p
+/// moves it by beta times this). coloured_sweeps.cpp says why the step is made per body.
+struct BodyStep {
+  Vec2 v0;
+  double w0 = 0.0;
+  Vec2 dv;
+  double dw = 0.0;
+};
 
 /// Room enough for the bundles of a coloured solve of `manifolds` manifolds: a colour of k
 /// manifolds takes ceil(k / 4) bundles, at most k, over 63 colours (the rest are swept as rows):
