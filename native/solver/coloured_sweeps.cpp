@@ -136,6 +136,10 @@ FLOEDEM_LANES void take_step(const PendingStep& pending, const double* change, d
 struct BundleNncg {
   double* change = nullptr;
   double* direction = nullptr;
+  // The values of the bundle `j` places on (none without NNCG).
+  BundleNncg at(std::size_t j) const {
+    return change == nullptr ? BundleNncg{} : BundleNncg{change + kBundleNncg * j, direction + kBundleNncg * j};
+  }
 };
 
 // Point k of a bundle: its local solve and impulse. Returns |dP|^2 per lane (NNCG's merit: the
@@ -195,16 +199,13 @@ FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, d
                                       const PendingStep& pending) {
   v4d largest_change = splat(0.0), largest_impulse = splat(0.0), size = splat(0.0);
   const bool accelerate = nncg.change != nullptr;
-  auto values = [&](std::size_t j) {
-    return accelerate ? BundleNncg{nncg.change + kBundleNncg * j, nncg.direction + kBundleNncg * j} : BundleNncg{};
-  };
   std::size_t i = 0;
   for (; i + 1 < bundles.size(); i += 2) {
     SweepBundle &b0 = bundles[i], &b1 = bundles[i + 1];
     // Near the span's end: the colour's next block, or past the array (never faults).
     prefetch_record(bundles.data(), i + kSweepAhead, 2 * sizeof(SweepBundle));
     BundleRun r0 = start(b0, v, w), r1 = start(b1, v, w);
-    const BundleNncg c0 = values(i), c1 = values(i + 1);
+    const BundleNncg c0 = nncg.at(i), c1 = nncg.at(i + 1);
     v4d sq0[2], sq1[2];
     const int both = std::min(b0.points, b1.points);
     for (int k = 0; k < both; ++k) {
@@ -223,7 +224,7 @@ FLOEDEM_LANES SweepResult sweep_lanes(std::span<SweepBundle> bundles, Vec2* v, d
   if (i < bundles.size()) {
     SweepBundle& b = bundles[i];
     BundleRun r = start(b, v, w);
-    const BundleNncg c = values(i);
+    const BundleNncg c = nncg.at(i);
     for (int k = 0; k < b.points; ++k) {
       const v4d sq = sweep_point(b, k, r, largest_change, largest_impulse, c, pending);
       if (accelerate) size = size + sq;
@@ -600,8 +601,7 @@ constexpr std::size_t kBlock = 64;  // bundles: 256 manifolds, about 5 us of a s
 constexpr std::size_t kPoolBlocks = 4;
 
 // fn(begin, end) over the blocks of kBlock bundles of one colour of `count` bundles, in order on
-// this thread, or on the pool's threads with `threads` and kPoolBlocks blocks or more: the rule
-// the sweep and NNCG's step share.
+// this thread, or on the pool's threads with `threads` and kPoolBlocks blocks or more.
 template <class F>
 void colour_blocks(std::size_t count, bool threads, F&& fn) {
   if (threads && count >= kPoolBlocks * kBlock) {
@@ -619,12 +619,6 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
   Vec2* const v = s.velocity.data();
   double* const w = s.angular_velocity.data();
   SweepResult total;
-  // The NNCG values of the bundle `first` (of the solve's) on.
-  auto at = [&](std::size_t first) {
-    return nncg.change == nullptr
-               ? BundleNncg{}
-               : BundleNncg{nncg.change + kBundleNncg * first, nncg.direction + kBundleNncg * first};
-  };
   auto add = [&](const SweepResult& r) {
     total.largest_change = std::max(total.largest_change, r.largest_change);
     total.largest_impulse = std::max(total.largest_impulse, r.largest_impulse);
@@ -638,7 +632,7 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
     if (blocks.size() < count) blocks.resize(count + count / 2);  // no allocation per step once grown
     colour_blocks(colour.size(), threads, [&](std::size_t begin, std::size_t end) {
       blocks[begin / kBlock] =
-          sweep_once(colour.subspan(begin, end - begin), v, w, at(g.colour_start[c] + begin), pending);
+          sweep_once(colour.subspan(begin, end - begin), v, w, nncg.at(g.colour_start[c] + begin), pending);
     });
     for (std::size_t b = 0; b < count; ++b) add(blocks[b]);
   }
