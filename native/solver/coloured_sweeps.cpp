@@ -17,6 +17,7 @@
 #include "parallel/thread_pool.hpp"
 #include "solver/local_law.hpp"
 #include "solver/sweep_row.hpp"
+#include "solver/sweep_schedule.hpp"
 
 // The conditions each point's local solve meets, and the Delassus block, are stated in
 // contact_solver.cpp; the local solve is local_law (local_law.hpp), the one the sweeps in pair
@@ -99,13 +100,9 @@ FLOEDEM_LANES BundleRun start(const SweepBundle& b, const Vec2* v, const double*
   return {gather(b.body_a, v, w), gather(b.body_b, v, w), load(b.nx), load(b.ny), load(b.friction)};
 }
 
-// NNCG's step as the sweep after the one that called for it takes it (solve_coloured says why):
-// `start`, p = r (the first step, beta = 0); `step`, the impulses P += beta p, then
-// p = beta p + r; `restart`, p = 0 (the merit rose). r is the last sweep's change.
-struct PendingStep {
-  enum class Kind { none, start, step, restart } kind = Kind::none;
-  double beta = 0.0;
-};
+// NNCG's step (ConjugateStep, sweep_schedule.hpp), taken by the sweep after the one that called
+// for it (solve_coloured says why); r is the last sweep's change.
+using PendingStep = ConjugateStep;
 
 // The pending step at one point of a bundle (`change` and `direction` its n then t values, four
 // lanes each): the step's impulse added to pn and pt, the point's impulses before its solve.
@@ -772,14 +769,12 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
     moving = list_moving_bodies(bundles, s, space);
   }
   const BundleNncg nncg = accelerate ? BundleNncg{change.data(), direction.data()} : BundleNncg{};
-  // run_sweeps' loop (contact_solver.cpp), over the bundles and then the rows beyond the colours,
-  // NNCG's step made by the sweep after the one that calls for it (step_bodies' comment).
-  double previous_size = 0.0;
-  int max_iterations = limits.iterations;
-  int sweep = 0;
+  // run_sweeps' loop (contact_solver.cpp) on the same SweepSchedule, over the bundles and then the
+  // rows beyond the colours, NNCG's step made by the sweep after the one that calls for it
+  // (step_bodies' comment).
+  SweepSchedule schedule(limits);
   PendingStep pending;
-  while (sweep < max_iterations) {
-    ++sweep;
+  while (schedule.next()) {
     if (pending.kind != PendingStep::Kind::none)
       step_bodies(moving, s, space.body_steps, pending, /*measured=*/!rows.empty(), threads);
     SweepResult r = sweep_colours(bundles, g, s, nncg, pending, threads);
@@ -790,23 +785,13 @@ int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> 
       r.largest_change = std::max(r.largest_change, std::abs(d.normal) + std::abs(d.tangent));
       r.largest_impulse = std::max(r.largest_impulse, row.normal_impulse + std::abs(row.tangent_impulse));
     }
-    if (r.largest_change <= limits.tolerance * r.largest_impulse) break;
-    if (sweep >= limits.iterations && (sweep - limits.iterations) % SweepLimits::check_every == 0 &&
-        limits.extra_iterations > 0) {
-      if (std::max(largest_shortfall_of(bundles, s), largest_shortfall_of(rows, s)) <= limits.closing_speed) break;
-      max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + SweepLimits::check_every);
-    }
-    if (!accelerate || sweep == max_iterations) continue;
-    if (previous_size > 0.0 && r.size > previous_size)
-      pending.kind = PendingStep::Kind::restart;  // the merit rose: restart
-    else if (previous_size > 0.0)
-      pending = {PendingStep::Kind::step, r.size / previous_size};
-    else
-      pending.kind = PendingStep::Kind::start;
-    previous_size = r.size;
+    if (schedule.done(r.largest_change, r.largest_impulse,
+                      [&] { return std::max(largest_shortfall_of(bundles, s), largest_shortfall_of(rows, s)); }))
+      break;
+    if (accelerate && !schedule.last()) pending = schedule.conjugate_step(r.size);
   }
   scatter_bundles(m, bundles, rows, space.overflow.first(g.overflow), threads);
-  return sweep;
+  return schedule.sweeps();
 }
 
 }  // namespace floedem

@@ -12,6 +12,7 @@
 #include "solver/headroom.hpp"
 #include "solver/local_law.hpp"
 #include "solver/sweep_row.hpp"
+#include "solver/sweep_schedule.hpp"
 
 // Contact constraint, per point, between bodies a and b (normal n from a to b, tangent t = k x n):
 //
@@ -90,8 +91,9 @@ void apply_accumulated_impulses(std::span<const Manifold> manifolds, BodyArrays&
 // sweep left (the jam at dt 0.5 s: 0.04 m/s, 20 mm a step, more than the position projection
 // takes back). Past `iterations`, the sweeps go on while a point approaches faster than its
 // target by more than `closing_speed` (the engine's: allowed_penetration / dt, the overlap the
-// step may add), looked at every kCheckEvery sweeps, up to `extra_iterations` more; once a pack
-// holds, the warm start keeps it within the ordinary limit.
+// step may add), looked at every SweepLimits::check_every sweeps, up to `extra_iterations` more;
+// once a pack holds, the warm start keeps it within the ordinary limit. SweepSchedule
+// (sweep_schedule.hpp) holds these rules and the step's below, for both sweep orders.
 //
 // Acceleration (Silcowitz, Niebe and Erleben 2010, "A nonsmooth nonlinear conjugate gradient
 // method for interactive contact force problems", The Visual Computer 26(6-8), alg. 2): a sweep
@@ -111,7 +113,6 @@ void apply_accumulated_impulses(std::span<const Manifold> manifolds, BodyArrays&
 // |P_t| > mu P_n) is brought back by the next sweep; the solve always ends on a sweep, never on
 // a step, so its impulses keep their laws.
 namespace {
-constexpr int kCheckEvery = SweepLimits::check_every;
 
 // The manifolds a solve runs over: all of a span, or an island's (indices into it, in order).
 struct AllRows {
@@ -168,18 +169,8 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
     std::fill(work.change.begin(), work.change.end(), 0.0);
     std::fill(work.direction.begin(), work.direction.end(), 0.0);
   }
-  double previous_size = 0.0;  // |r_k|^2; 0 before the first sweep
-  int max_iterations = limits.iterations;
-  int sweep = 0;
-  // The look at what is left closing, past `iterations` every kCheckEvery sweeps: false once no
-  // point is; else true, the limit moved on by kCheckEvery sweeps (within the extra sweeps).
-  auto still_closing = [&] {
-    if (largest_shortfall_of(rows, s) <= limits.closing_speed) return false;
-    max_iterations = std::min(limits.iterations + limits.extra_iterations, sweep + kCheckEvery);
-    return true;
-  };
-  while (sweep < max_iterations) {
-    ++sweep;
+  SweepSchedule schedule(limits);
+  while (schedule.next()) {
     double largest_change = 0.0;
     double largest_impulse = 0.0;
     double size = 0.0;  // |r_{k+1}|^2
@@ -195,17 +186,15 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
         size += dpn * dpn + dpt * dpt;
       }
     }
-    if (largest_change <= limits.tolerance * largest_impulse) break;
-    if (sweep >= limits.iterations && (sweep - limits.iterations) % kCheckEvery == 0 && limits.extra_iterations > 0 &&
-        !still_closing())
-      break;
-    if (!accelerate || sweep == max_iterations) continue;
+    if (schedule.done(largest_change, largest_impulse, [&] { return largest_shortfall_of(rows, s); })) break;
+    if (!accelerate || schedule.last()) continue;
     const std::span<double> p = work.direction;
     const std::span<const double> r = work.change;
-    if (previous_size > 0.0 && size > previous_size) {
-      std::fill(p.begin(), p.end(), 0.0);  // the merit rose: restart
+    const ConjugateStep c = schedule.conjugate_step(size);
+    if (c.kind == ConjugateStep::Kind::restart) {
+      std::fill(p.begin(), p.end(), 0.0);
     } else {
-      const double beta = previous_size > 0.0 ? size / previous_size : 0.0;
+      const double beta = c.beta;  // 0 at the start: p = r, no step
       // Over the dense arrays, in two passes: the step beta p and the new direction (a loop
       // the compiler vectorises), then the step applied where it is not zero: a point that
       // neither moved nor carries a direction (a speculative contact kept apart) costs no look
@@ -224,9 +213,8 @@ int run_sweeps(std::span<SweepRow> rows, BodyArrays& s, const SweepLimits& limit
         q.tangent_impulse += st;
       }
     }
-    previous_size = size;
   }
-  return sweep;
+  return schedule.sweeps();
 }
 
 template <class Rows>
