@@ -10,8 +10,9 @@ seconds="${1:-60}"
 bash "$root/scripts/setup.sh"
 build="${FLOEDEM_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 jobs="$(nproc 2>/dev/null || echo 2)"
-CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLOEDEM_FUZZ=ON \
-  -DBUILD_TESTING=OFF >/dev/null
+# -g1 (line tables): enough for file:line in a crash's stack trace, and a faster build than -g.
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DFLOEDEM_FUZZ=ON -DBUILD_TESTING=OFF >/dev/null
 cmake --build "$build" -j "$jobs" --target fuzz_scenario fuzz_contact fuzz_h5
 cd "$build"
 # The HDF5 seeds are stored gzipped (tests/fuzz/make_h5_corpus.sh): unpacked here.

@@ -15,7 +15,11 @@ mode="${1:-}"
 case "$mode" in
   --sanitize)
     build="${FLOEDEM_BUILD_DIR:-$root/build-sanitize}"
-    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLOEDEM_SANITIZE=ON >/dev/null
+    # -g1: line tables, all a sanitizer's stack trace needs (file:line per frame). Full -g
+    # spends about half the compile of the test files on variable locations (Catch2's main:
+    # 125 s against 66 s on one core) that a report never prints.
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
+      -DFLOEDEM_SANITIZE=ON >/dev/null
     cmake --build "$build" -j "$jobs"
     export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:${ASAN_OPTIONS:-}"
     export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
