@@ -36,8 +36,11 @@ the page and the CSVs disagree.
   step over the last S seconds of model time, set-up time, the fraction of floes in contact,
   the deepest and mean penetration, heap allocations per step, peak memory, and with
   `--stages` the mean ms per step of each stage (`stage_ms`; the stages are listed in
-  [architecture.md](architecture.md)). Each row names the machine (host, CPU model with family,
-  model and cache sizes, threads) and the build.
+  [architecture.md](architecture.md)). The `work` column counts the engine's work per timed
+  step (native: `sweeps`, its longest island's velocity sweeps; `islands`; `redetections`, the
+  steps solved again), so that a step that does more work is told from one whose work costs
+  more. Each row names the machine (host, CPU model with family, model and cache sizes,
+  threads) and the build.
 - **One run at a time, single thread**, unless threads are what is measured: a timing that
   shares the cores with another job is not a timing.
 - **Ratios, not absolute times**, between engines or builds, from runs made side by side on the

@@ -28,7 +28,7 @@ namespace {
 constexpr const char* kHeader =
     "host,cpu,threads,floedem_version,scenario,overrides,engine,engine_version,bodies,moving_bodies,dt,steps,"
     "timed_steps,median_ms,mean_ms,p10_ms,p90_ms,setup_s,total_s,contact_fraction,max_penetration_m,"
-    "mean_penetration_m,allocations_per_step,peak_rss_mb,stage_ms";
+    "mean_penetration_m,allocations_per_step,peak_rss_mb,stage_ms,work";
 
 /// The processor as far as this machine tells: its model name, and its family, model and cache
 /// sizes, since a virtual machine's model name alone ("AMD EPYC") names processors generations
@@ -126,6 +126,11 @@ int run_bench_command(const BenchCommand& c) {
   std::ostringstream stages;
   stages.precision(4);
   for (const StageTime& t : r.stages) stages << (stages.tellp() > 0 ? " " : "") << t.name << '=' << 1e3 * t.seconds;
+  // The engine's work a timed step, "name=count" separated by spaces (native: its sweeps, islands
+  // and redetections; empty for an engine that counts none).
+  std::ostringstream work;
+  work.precision(4);
+  for (const WorkCount& w : r.work) work << (work.tellp() > 0 ? " " : "") << w.name << '=' << w.count;
   const double peak_mb = peak_resident_mb();
 
   std::string overrides;
@@ -137,7 +142,8 @@ int run_bench_command(const BenchCommand& c) {
       << field(r.engine_version) << ',' << scene.bodies.size() << ',' << r.moving_bodies << ',' << scene.run.dt << ','
       << r.steps << ',' << r.timed_steps << ',' << r.median_ms << ',' << r.mean_ms << ',' << r.p10_ms << ',' << r.p90_ms
       << ',' << loading + r.setup_seconds << ',' << loading + r.total_seconds << ',' << r.contact_fraction << ',' << r.max_penetration << ','
-      << r.mean_penetration << ',' << r.allocations_per_step << ',' << peak_mb << ',' << field(stages.str());
+      << r.mean_penetration << ',' << r.allocations_per_step << ',' << peak_mb << ',' << field(stages.str()) << ','
+      << field(work.str());
   std::cout << kHeader << '\n' << row.str() << '\n';
   if (!c.csv.empty()) {
     const std::filesystem::path dir = std::filesystem::path(c.csv).parent_path();

@@ -42,9 +42,11 @@ BenchResult bench_scene(const Scene& scene, const BenchOptions& options) {
   double contact_fraction_sum = 0.0, penetration_sum = 0.0;
   std::int64_t overlaps = 0;
   std::uint64_t allocations_at_window = 0;
+  std::vector<WorkCount> work_at_window;
   auto last_progress = clock::now();
   for (std::int64_t k = 1; k <= r.steps; ++k) {
     if (k == first_timed) {
+      stepper.engine().add_work_counts(work_at_window);  // before the count: its strings are not a step's
       if (options.allocations) allocations_at_window = options.allocations();
       stepper.time_stages(options.stages);  // the stages' sums cover the timed steps alone
     }
@@ -80,6 +82,9 @@ BenchResult bench_scene(const Scene& scene, const BenchOptions& options) {
       t.seconds /= timed;
       r.stages.push_back(t);
     }
+  stepper.engine().add_work_counts(r.work);
+  for (std::size_t i = 0; i < r.work.size() && i < work_at_window.size(); ++i)
+    r.work[i].count = (r.work[i].count - work_at_window[i].count) / timed;
   for (const Vec2 p : stepper.state().position)
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) throw SolverFailure("non-finite body state at the end of the run");
   r.total_seconds = std::chrono::duration<double>(clock::now() - start).count();

@@ -64,6 +64,13 @@ class NativeEngine final : public Engine {
   EngineInfo info() const override;
   void time_stages(bool on) override { stages_.enable(on); }
   void add_stage_times(std::vector<StageTime>& out) const override { stages_.add_to(out); }
+  // sweeps: each step's longest island's velocity sweeps (the step's critical path on any
+  // number of threads); islands: the islands solved; redetections: the steps solved again.
+  void add_work_counts(std::vector<WorkCount>& out) const override {
+    out.push_back({"sweeps", static_cast<double>(total_sweeps_)});
+    out.push_back({"islands", static_cast<double>(total_islands_)});
+    out.push_back({"redetections", static_cast<double>(redetections_)});
+  }
   bool save_state(StateWriter& out) const override;
   void restore_state(StateReader& in) override;
 

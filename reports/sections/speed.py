@@ -221,13 +221,24 @@ def sleep_table(sleeping):
     return md + [""]
 
 
-def stages(row):
-    """A bench row's stage_ms column ("name=ms ..."): {stage: mean ms per timed step}, in order."""
+def name_values(text):
+    """A bench row's "name=value ..." column as {name: value}, in order."""
     out = {}
-    for item in (row.get("stage_ms") or "").split():
-        name, _, ms = item.partition("=")
-        out[name] = float(ms)
+    for item in (text or "").split():
+        name, _, value = item.partition("=")
+        out[name] = float(value)
     return out
+
+
+def stages(row):
+    """A bench row's stage_ms column: {stage: mean ms per timed step}, in order."""
+    return name_values(row.get("stage_ms"))
+
+
+def work(row):
+    """A bench row's work column: {count: mean per timed step} (native: sweeps, islands,
+    redetections; empty for an engine that counts none, or a row from before the column)."""
+    return name_values(row.get("work"))
 
 
 # The stages of a native step as the report names them, in the order of a step: filled once from
@@ -334,6 +345,14 @@ def stages_scaling(small, large, setting):
             f"{sum(b.values()) / linear:.2f} times. The largest stage, {STAGE_LABELS[biggest]} "
             f"({100 * b[biggest] / sum(b.values()):.0f} % of the step), grows {growth.get(biggest, 0.0):.2f} times "
             "per floe. ")
+    sweeps = [work(r).get("sweeps") for r in (small, large)]
+    if None not in sweeps:
+        # Within a sweep of each other: the fields differ only in length (the same contacts per
+        # floe), so the solve's growth per floe is then the cost of a sweep.
+        same = abs(sweeps[1] - sweeps[0]) < 1.0
+        text += (f"A step's sweeps (its longest island's, mean): {sweeps[0]:.1f} at {n_small} floes and "
+                 f"{sweeps[1]:.1f} at {n_large}" + ("; the same number, so the contact solve's growth per floe is "
+                                                   "in the cost of a sweep, not in their number. " if same else ". "))
     if grown:
         text += ("Stages whose cost per floe grows more than 1.5 times: " +
                  ", ".join(f"{STAGE_LABELS[k]} {g:.1f} times ({a[k]:.2f} -> {b[k]:.1f} ms)" for k, g in grown) +

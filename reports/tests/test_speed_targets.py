@@ -45,6 +45,14 @@ def test_scaling_names_the_stage_that_grows_and_the_largest():
     assert "redetect 2.0 times (0.20 -> 2.5 ms)" in text        # grown by 1.5 times or more: named
     assert "forcing" not in text.split("more than 1.5 times")[1]   # the same per floe: not named
     assert speed.stages_scaling(small, None, "x") == []
+    assert "sweeps" not in text                                  # rows from before the work column
+    small["work"], large["work"] = "sweeps=50 islands=103 redetections=0.17", "sweeps=50 islands=743 redetections=0.56"
+    text = " ".join(speed.stages_scaling(small, large, "native's defaults"))
+    assert ("A step's sweeps (its longest island's, mean): 50.0 at 16000 floes and 50.0 at 100000; the same "
+            "number, so the contact solve's growth per floe is in the cost of a sweep, not in their number.") in text
+    large["work"] = "sweeps=62.5"
+    text = " ".join(speed.stages_scaling(small, large, "native's defaults"))
+    assert "50.0 at 16000 floes and 62.5 at 100000. " in text and "cost of a sweep" not in text
 
 
 def test_two_threads_against_their_target():

@@ -141,7 +141,10 @@ TEST_CASE("cli: floedem bench prints and appends one CSV row, bad input exits 2"
   CHECK(header.rfind("host,cpu,threads,", 0) == 0);
   CHECK(row.find(",native,floedem,2,2,") != std::string::npos);  // engine, version, bodies, moving
   CHECK(first.find("contact_solve=") != std::string::npos);  // --stages: native times its own stages
-  CHECK(row.back() == ',');                                   // without: stage_ms is left empty
+  CHECK(row.find(",,sweeps=") != std::string::npos);          // without: stage_ms is left empty
+  CHECK(header.ends_with(",stage_ms,work"));  // the work column last
+  CHECK(row.find(" islands=") != std::string::npos);
+  CHECK(row.find(" redetections=") != std::string::npos);
   // A file of other columns (an older bench's) is not appended to: the row would not fit.
   const fs::path old_csv = d / "old.csv";
   const std::string old_rows = "host,cpu,threads,median_ms\nvm,x,1,1.0\n";

@@ -95,6 +95,13 @@ inline std::string setting_text(double v) {
 }
 
 /// What an engine says about itself; written into the output's attributes.
+/// A count of an engine's work, summed over its steps (`floedem bench` gives it per timed step):
+/// what separates a step that does more work from one whose work costs more.
+struct WorkCount {
+  std::string name;
+  double count = 0.0;
+};
+
 struct EngineInfo {
   std::string name;
   std::string version;
@@ -133,6 +140,9 @@ class Engine {
   virtual void time_stages(bool /*on*/) {}
   /// Appends each stage's summed wall time, in the order step() makes them.
   virtual void add_stage_times(std::vector<StageTime>& /*out*/) const {}
+  /// Appends the engine's counts of its work since it was built (the same names every call, in
+  /// the same order). An engine that counts nothing adds none.
+  virtual void add_work_counts(std::vector<WorkCount>& /*out*/) const {}
 };
 
 }  // namespace floedem

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "floedem/engine/engine.hpp"
 #include "floedem/engine/stage_clock.hpp"
 #include "floedem/scene/scene.hpp"
 
@@ -36,6 +37,7 @@ struct BenchResult {
   double mean_penetration = 0.0;   ///< m, mean over the overlapping contact points
   double allocations_per_step = 0.0;  ///< NaN when not counted
   std::vector<StageTime> stages;   ///< mean seconds a timed step per stage (BenchOptions::stages)
+  std::vector<WorkCount> work;     ///< the engine's work counts, mean a timed step (Engine::add_work_counts)
 };
 
 /// Runs the scene without output and times it. InputError for a run shorter than one step or
