@@ -26,8 +26,8 @@ TARGET_VS = {"box2d": 3.0, "bullet": 6.0}     # native at least this much faster
 TARGET_100K_MS = 80.0                          # ms per step for 10^5 floes, native
 TARGET_TOWING = {"ode": 10.0, "bullet": 10.0}  # native at least 10x faster on the towing case
 # A step of the 10^5 field at most this many times the 16k field's per floe, native's defaults:
-# the fields differ only in the strip's length, so the work per floe is the same and a linear
-# solver keeps its cost per floe; what grows is the machine's (a working set beyond the cache).
+# the fields differ only in the strip's length, so the work per floe is the same, and a solver
+# whose work grows linearly with the floes keeps its cost per floe wherever memory keeps up.
 TARGET_PER_FLOE = 1.1
 ITERATIONS_KEY = {"native": "velocity_iterations", "box2d": "velocity_iterations", "bullet": "iterations",
                   "ode": "iterations"}
@@ -311,6 +311,7 @@ def stages_section(ctx, rows, defaults):
         md += stages_scaling(chosen.get(f"speed_{what}_16k_native"), chosen.get(f"speed_{what}_100k_native"),
                              "native's defaults" if what == "default" else f"{EQUAL_ITERATIONS} plain sweeps")
     md += stages_against_box2d(rows)
+
     def setting(tag):
         if tag.startswith("speed_default"):
             return f"{label(tag)}, defaults"

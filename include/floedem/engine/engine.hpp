@@ -94,7 +94,6 @@ inline std::string setting_text(double v) {
   return b;
 }
 
-/// What an engine says about itself; written into the output's attributes.
 /// A count of an engine's work, summed over its steps (`floedem bench` gives it per timed step):
 /// what separates a step that does more work from one whose work costs more.
 struct WorkCount {
@@ -102,6 +101,7 @@ struct WorkCount {
   double count = 0.0;
 };
 
+/// What an engine says about itself; written into the output's attributes.
 struct EngineInfo {
   std::string name;
   std::string version;
