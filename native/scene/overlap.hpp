@@ -12,8 +12,9 @@ struct BodyOverlap {
   double depth = 0.0;  ///< m, penetration along the separating axis of least overlap
 };
 
-/// The first pair of bodies (in index order of a) whose polygons overlap at t = 0 by more
-/// than round-off (touching is allowed). Sweep and prune on x, exact SAT on convex parts.
+/// The first pair of bodies (in index order of a, then b) whose polygons overlap at t = 0 by
+/// more than round-off (touching is allowed), with the deepest overlap of their parts. The
+/// broad phase's grid for candidates, exact SAT on convex parts.
 std::optional<BodyOverlap> find_overlap(const Scene& scene);
 
 }  // namespace floedem
