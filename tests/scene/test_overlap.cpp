@@ -15,35 +15,38 @@ using namespace floedem;
 
 namespace {
 
-/// The same answer by brute force: every pair of parts of distinct bodies.
+/// The same answer by brute force: every pair of parts of distinct bodies whose boxes overlap.
 std::optional<BodyOverlap> all_pairs(const Scene& scene) {
-  auto world = [&](std::size_t i, const std::vector<Vec2>& local) {
-    std::vector<Vec2> v;
-    for (const Vec2 p : local) v.push_back(scene.bodies[i].centroid + p);
-    return v;
+  struct Part {
+    std::size_t body;
+    std::vector<Vec2> vertices, normals;
+    Aabb box;
   };
-  auto normals = [](const std::vector<Vec2>& v) {
-    std::vector<Vec2> n;
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      const Vec2 p = v[k], q = v[(k + 1) % v.size()];
-      n.push_back(normalized(Vec2{q.y - p.y, p.x - q.x}));
-    }
-    return n;
-  };
-  std::optional<BodyOverlap> found;
+  std::vector<Part> parts;
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
-    for (std::size_t j = i + 1; j < scene.bodies.size(); ++j)
-      for (const auto& pi : scene.bodies[i].local_parts)
-        for (const auto& pj : scene.bodies[j].local_parts) {
-          const auto vi = world(i, pi), vj = world(j, pj), ni = normals(vi), nj = normals(vj);
-          const ConvexView a{vi.data(), ni.data(), static_cast<int>(vi.size())};
-          const ConvexView b{vj.data(), nj.data(), static_cast<int>(vj.size())};
-          const double sep = std::max(max_face_separation(a, b).separation, max_face_separation(b, a).separation);
-          const double tolerance = 1e-9 * (length(bounds_of(vi).hi - bounds_of(vi).lo) +
-                                           length(bounds_of(vj).hi - bounds_of(vj).lo));
-          if (sep < -tolerance && (!found || (found->a == i && found->b == j && -sep > found->depth)))
-            found = BodyOverlap{i, j, -sep};
-        }
+    for (const auto& local : scene.bodies[i].local_parts) {
+      Part p{i, {}, {}, {}};
+      for (const Vec2 v : local) p.vertices.push_back(scene.bodies[i].centroid + v);
+      for (std::size_t k = 0; k < p.vertices.size(); ++k) {
+        const Vec2 a = p.vertices[k], b = p.vertices[(k + 1) % p.vertices.size()];
+        p.normals.push_back(normalized(Vec2{b.y - a.y, a.x - b.x}));
+      }
+      p.box = bounds_of(p.vertices);
+      parts.push_back(std::move(p));
+    }
+  std::optional<BodyOverlap> found;
+  for (const Part& p : parts)
+    for (const Part& q : parts) {
+      if (p.body >= q.body || !p.box.overlaps(q.box)) continue;
+      const ConvexView a{p.vertices.data(), p.normals.data(), static_cast<int>(p.vertices.size())};
+      const ConvexView b{q.vertices.data(), q.normals.data(), static_cast<int>(q.vertices.size())};
+      const double sep = std::max(max_face_separation(a, b).separation, max_face_separation(b, a).separation);
+      const double tolerance = 1e-9 * (length(p.box.hi - p.box.lo) + length(q.box.hi - q.box.lo));
+      if (!(sep < -tolerance)) continue;
+      const BodyOverlap o{p.body, q.body, -sep};
+      if (!found || o.a < found->a || (o.a == found->a && (o.b < found->b || (o.b == found->b && o.depth > found->depth))))
+        found = o;
+    }
   return found;
 }
 
