@@ -12,8 +12,27 @@
 Files of another layout (format_version) or damaged ones raise floedem.FileError naming the
 file, the dataset and what was expected. The layout is docs/output.md of the repository.
 """
-from .run import FORMAT_VERSION, FileError, Run, open  # noqa: F401  (open: the module's entry point)
-from . import stats  # noqa: F401
+import importlib
+
+from .errors import FileError  # noqa: F401
+
+# numpy and h5py load on the first use of what needs them (PEP 562), not at `import floedem`:
+# the workflow runs `python3 -m floedem launch-one` once per job, hundreds of times a report.
+_LAZY = {"open": "run", "Run": "run", "FORMAT_VERSION": "run", "stats": None}
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'floedem' has no attribute {name!r}")
+    module = importlib.import_module(f".{_LAZY[name] or name}", __name__)
+    value = module if _LAZY[name] is None else getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __version__ = "0.1.0"
 __all__ = ["open", "Run", "FileError", "FORMAT_VERSION", "stats", "__version__"]

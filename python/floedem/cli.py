@@ -4,7 +4,7 @@
 import argparse
 import sys
 
-from .run import FileError
+from .errors import FileError
 
 
 def main(argv=None):

@@ -4,14 +4,11 @@ import os
 import h5py
 import numpy as np
 
+from .errors import FileError  # noqa: F401  (raised here; floedem.FileError)
+
 #: The output layout this package reads: the root attribute `format_version` of floedem's files
 #: (docs/output.md; the C++ library's kOutputFormatVersion).
 FORMAT_VERSION = 1
-
-
-class FileError(ValueError):
-    """A file that is not floedem's, of another format_version, or damaged: one line naming the
-    file, the dataset and what was expected."""
 
 
 # Each table: its datasets and their shapes after the row count ("N": bodies, "B": load bodies).
