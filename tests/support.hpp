@@ -20,7 +20,7 @@
 
 namespace floedem::test {
 
-/// True in a build under AddressSanitizer (scripts/test.sh --sanitize, the fuzz build): a test
+/// True in a build under AddressSanitizer (scripts/test.sh --sanitize): a test
 /// whose long run adds no check there may run shorter.
 #if defined(__SANITIZE_ADDRESS__)
 inline constexpr bool kSanitized = true;

@@ -201,7 +201,7 @@ TEST_CASE("cli: no heap allocation in the steady state of a packed field", "[cli
   // as the pack breathes, shows here. The direct solve of heavy-light islands (Eigen's sparse
   // LDLT), which still allocates, is not taken by this field of floes alone.
   const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml";
-  // Under a sanitizer (which counts operator new alone, not malloc) the run is ten times slower
+  // Under a sanitizer (which counts operator new alone, not malloc) the run is five times slower
   // and adds memory checks, not another count: the threaded path only, which has the pool's
   // lists besides the one-thread path's. The plain build checks both.
   const std::vector<const char*> thread_counts =
