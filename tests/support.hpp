@@ -20,20 +20,6 @@
 
 namespace floedem::test {
 
-/// True in a build under AddressSanitizer (scripts/test.sh --sanitize): a test
-/// whose long run adds no check there may run shorter.
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-inline constexpr bool kSanitized = true;
-#else
-inline constexpr bool kSanitized = false;
-#endif
-#else
-inline constexpr bool kSanitized = false;
-#endif
-
 /// The floedem command line run with `args`: exit code and stdout + stderr together.
 struct CliResult {
   int code;

@@ -13,14 +13,8 @@
 #include <cstdlib>
 #include <new>
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-#define FLOEDEM_SANITIZER_ALLOCATOR 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define FLOEDEM_SANITIZER_ALLOCATOR 1
-#endif
+#include "app/sanitizer.hpp"
+
 #if defined(__GLIBC__) && !defined(FLOEDEM_SANITIZER_ALLOCATOR)
 #define FLOEDEM_COUNT_MALLOC 1
 #endif

@@ -1,6 +1,7 @@
 #include "scene/overlap.hpp"
 
 #include <algorithm>
+#include <tuple>
 
 #include "geometry/polygon.hpp"
 #include "geometry/sat.hpp"
@@ -50,8 +51,7 @@ std::optional<BodyOverlap> find_overlap(const Scene& scene) {
       const auto ba = static_cast<std::size_t>(body[pair.a]), bb = static_cast<std::size_t>(body[pair.b]);
       const BodyOverlap o{std::min(ba, bb), std::max(ba, bb), -sep};
       // The first pair of bodies, and of its parts the deepest overlap.
-      if (!found || o.a < found->a || (o.a == found->a && (o.b < found->b || (o.b == found->b && o.depth > found->depth))))
-        found = o;
+      if (!found || std::tuple(o.a, o.b, -o.depth) < std::tuple(found->a, found->b, -found->depth)) found = o;
     }
   }
   return found;

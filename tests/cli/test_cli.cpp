@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 
+#include "app/sanitizer.hpp"
 #include "support.hpp"
 
 namespace fs = std::filesystem;
@@ -205,7 +206,7 @@ TEST_CASE("cli: no heap allocation in the steady state of a packed field", "[cli
   // and adds memory checks, not another count: the threaded path only, which has the pool's
   // lists besides the one-thread path's. The plain build checks both.
   const std::vector<const char*> thread_counts =
-      floedem::test::kSanitized ? std::vector<const char*>{"2"} : std::vector<const char*>{"1", "2"};
+      floedem::kSanitizerAllocator ? std::vector<const char*>{"2"} : std::vector<const char*>{"1", "2"};
   for (const char* threads : thread_counts) {
     INFO("FLOEDEM_THREADS=" << threads);
     const auto row = bench_row(scenario + " --window 50 -q", std::string("FLOEDEM_THREADS=") + threads + " ");

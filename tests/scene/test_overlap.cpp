@@ -54,8 +54,8 @@ std::optional<BodyOverlap> all_pairs(const Scene& scene) {
 
 TEST_CASE("overlap check: the first overlapping pair of bodies, as every pair of parts finds it", "[input]") {
   // Fields of floe-like polygons (some of two parts: an L of two boxes) with a power-law spread
-  // of sizes and one body far larger than the rest, scattered more or less densely: from none
-  // overlapping to many.
+  // of sizes and one body far larger than the rest, scattered more or less densely: from the
+  // large body's overlaps alone to many.
   for (const double spacing : {60.0, 25.0, 12.0}) {
     for (unsigned seed = 1; seed <= 4; ++seed) {
       INFO("spacing " << spacing << " seed " << seed);
