@@ -403,7 +403,7 @@ FLOEDEM_LANES void form_quad(LaneIo& io, const Group& g, const Slot* slot) {
     const v4d nx = k.c * nx0 - k.s * ny0, ny = k.s * nx0 + k.c * ny0;  // rot.apply(normal)
     const v4m past = v4m{} + static_cast<std::int64_t>(j) >= count;
     const v4d weight = -load(e.weight);
-    auto point = [&](v4d lx, v4d ly) {
+    auto point = [&](v4d lx, v4d ly) FLOEDEM_LANES_LAMBDA {
       v4d rx, ry, ux, uy;
       k.template at<rotational>(lx, ly, rx, ry, ux, uy);
       const v4d un = ux * nx + uy * ny;
@@ -433,7 +433,7 @@ FLOEDEM_LANES void skin_quad(LaneIo& io, const Group& g, const Slot* slot) {
   v4d q1 = io.gather([&](std::size_t b) { return io.q[b][1]; });
   v4d q2 = io.gather([&](std::size_t b) { return io.q[b][2]; });
   // One point's k |u| u and its moment, as add_skin_point adds them (-0 past the floe's end).
-  auto add = [&](v4m in, v4d rx, v4d ry, v4d ux, v4d uy, v4d m, v4d weight) {
+  auto add = [&](v4m in, v4d rx, v4d ry, v4d ux, v4d uy, v4d m, v4d weight) FLOEDEM_LANES_LAMBDA {
     const v4d km = weight * m;
     const v4d f_x = km * ux, f_y = km * uy;
     q0 += select(in, f_x, none);

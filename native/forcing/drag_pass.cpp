@@ -48,7 +48,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
   auto is_form = [&](int t) { return kTerms > 0 ? ((kForm >> t) & 1u) != 0 : shape.form[static_cast<std::size_t>(t)]; };
   const bool any_form = kTerms > 0 ? (kForm & ((1u << kTerms) - 1u)) != 0 : shape.any_form;
   const bool any_skin = kTerms > 0 ? (~kForm & ((1u << kTerms) - 1u)) != 0 : shape.any_skin;
-  auto gather = [&](auto f) { return lanes(f(g.body[0]), f(g.body[1]), f(g.body[2]), f(g.body[3])); };
+  auto gather = [&](auto f) FLOEDEM_LANES_LAMBDA { return lanes(f(g.body[0]), f(g.body[1]), f(g.body[2]), f(g.body[3])); };
   const v4d c = gather([&](std::uint32_t b) { return io.rot[b].c; });
   const v4d s = gather([&](std::uint32_t b) { return io.rot[b].s; });
   const v4d vx = gather([&](std::uint32_t b) { return io.v[b].x; });
@@ -60,8 +60,8 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
   std::memcpy(&count, g.count.data(), sizeof count);
   // Per term: its flow, and the lanes whose body moves with it without spin (the term adds
   // nothing there: lane_adds_nothing), which add -0.
-  v4d fx[kMaxTerms], fy[kMaxTerms];
-  v4m still[kMaxTerms];
+  v4d fx[kMaxTerms]{}, fy[kMaxTerms]{};  // zeroed: GCC cannot see that only terms < `terms` are read
+  v4m still[kMaxTerms]{};
 #pragma GCC unroll 4
   for (int t = 0; t < terms; ++t) {
     fx[t] = load(g.flow_x[t].data());
@@ -72,7 +72,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
   v4d q1 = gather([&](std::uint32_t b) { return io.q[b][1]; });
   v4d q2 = gather([&](std::uint32_t b) { return io.q[b][2]; });
   // A body-frame point turned into the world (rot.apply) and the velocity there (v + w k x r).
-  auto place = [&](v4d lx, v4d ly, v4d& rx, v4d& ry, v4d& px, v4d& py) {
+  auto place = [&](v4d lx, v4d ly, v4d& rx, v4d& ry, v4d& px, v4d& py) FLOEDEM_LANES_LAMBDA {
     rx = c * lx - s * ly;
     ry = s * lx + c * ly;
     px = rotational ? vx + neg_w * ry : vx;
@@ -87,7 +87,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
     base[t] = static_cast<std::uint32_t>(at);
     at += static_cast<int>(edges * (is_form(t) ? 2 : 3));
   }
-  auto keep = [&](int t, std::uint32_t k, v4d f_x, v4d f_y, v4d tq) {
+  auto keep = [&](int t, std::uint32_t k, v4d f_x, v4d f_y, v4d tq) FLOEDEM_LANES_LAMBDA {
     if (t == 0) {
       q0 += f_x;
       q1 += f_y;
@@ -99,7 +99,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
   // Skin: the half-vertex an edge shares with the one before (area_points' a / 2), carried:
   // its place, and per term its relative flow and |u|.
   v4d ax{}, ay{};
-  v4d aux[kMaxTerms], auy[kMaxTerms], am[kMaxTerms];
+  v4d aux[kMaxTerms]{}, auy[kMaxTerms]{}, am[kMaxTerms]{};  // set for the skin terms when any_skin
   if (any_skin) {
     v4d px, py;
     place(half * load(slot[0].corner_x), half * load(slot[0].corner_y), ax, ay, px, py);
@@ -139,7 +139,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
         // form_quad: -k (u.n) u where the flow meets the edge (u.n < 0), else -0.
         const v4d weight = -load(e.weight[t]);
         const v4m skip = past | still[t];
-        auto point = [&](std::uint32_t p, v4d rx, v4d ry, v4d px, v4d py) {
+        auto point = [&](std::uint32_t p, v4d rx, v4d ry, v4d px, v4d py) FLOEDEM_LANES_LAMBDA {
           const v4d ux = fx[t] - px, uy = fy[t] - py;
           const v4d un = ux * nx + uy * ny;
           const v4d kun = weight * un;
@@ -153,7 +153,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
         // skin_quad: k |u| u at the shared half-vertex, the next one and the middle.
         const v4d weight = load(e.weight[t]);
         const v4m in = ~(past | still[t]);
-        auto point = [&](std::uint32_t p, v4d rx, v4d ry, v4d ux, v4d uy, v4d m) {
+        auto point = [&](std::uint32_t p, v4d rx, v4d ry, v4d ux, v4d uy, v4d m) FLOEDEM_LANES_LAMBDA {
           const v4d km = weight * m;
           const v4d f_x = km * ux, f_y = km * uy;
           keep(t, 3 * j + p, select(in, f_x, none), select(in, f_y, none), select(in, rx * f_y - ry * f_x, none));
@@ -192,7 +192,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
 /// term's flow without spin (lane_adds_nothing: the terms add nothing there).
 FLOEDEM_LANES void bound(const DragPass::Shape& shape, const DragPass::Group& g, const DragPass::Moments& m,
                          const PassIo& io, std::array<double, 2>* rate_bound) {
-  auto gather = [&](auto f) { return lanes(f(g.body[0]), f(g.body[1]), f(g.body[2]), f(g.body[3])); };
+  auto gather = [&](auto f) FLOEDEM_LANES_LAMBDA { return lanes(f(g.body[0]), f(g.body[1]), f(g.body[2]), f(g.body[3])); };
   const v4d vx = gather([&](std::uint32_t b) { return io.v[b].x; });
   const v4d vy = gather([&](std::uint32_t b) { return io.v[b].y; });
   const v4d w = gather([&](std::uint32_t b) { return io.w[b]; });

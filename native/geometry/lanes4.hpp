@@ -14,12 +14,12 @@
 #include <cmath>
 #endif
 
+#include "geometry/lane_inline.hpp"
+
 namespace floedem::lanes4 {
 
 using v4d = double __attribute__((vector_size(32)));
 using v4m = std::int64_t __attribute__((vector_size(32)));
-
-#define FLOEDEM_LANES [[gnu::always_inline]] inline
 
 FLOEDEM_LANES v4d load(const double* p) {
   v4d v;

@@ -34,6 +34,8 @@
 #include <cmath>
 #include <limits>
 
+#include "geometry/lane_inline.hpp"
+
 namespace floedem {
 
 /// The operations local_law needs, on one double.
@@ -56,24 +58,24 @@ template <class Ops, class T = typename Ops::value>
   const T zero = Ops::splat(0.0), one = Ops::splat(1.0);
   const T need = target - ufn;
   // Each case's impulse and test, written once; the two evaluation orders below take them.
-  const auto frictionless_normal = [&] { return need * (one / wnn); };
-  const auto neither = [&](T pn_free) {  // friction clamped to the cone (std::clamp)
+  const auto frictionless_normal = [&]() FLOEDEM_LANES_LAMBDA { return need * (one / wnn); };
+  const auto neither = [&](T pn_free) FLOEDEM_LANES_LAMBDA {  // friction clamped to the cone (std::clamp)
     const T want = -(uft + wnt * pn_free) * (one / wtt);
     const T cone = mu * pn_free;
     return Ops::select(Ops::less(want, -cone), -cone, Ops::select(Ops::less(cone, want), cone, want));
   };
-  const auto inverse_det = [&] { return one / (wnn * wtt - wnt * wnt); };
-  const auto stick_tangent = [&](T inv_det) { return (-wnn * uft - wnt * need) * inv_det; };
-  const auto stick_normal = [&](T inv_det) { return (wtt * need + wnt * uft) * inv_det; };
-  const auto stick_holds = [&](T stick_pn, T stick_pt) {
+  const auto inverse_det = [&]() FLOEDEM_LANES_LAMBDA { return one / (wnn * wtt - wnt * wnt); };
+  const auto stick_tangent = [&](T inv_det) FLOEDEM_LANES_LAMBDA { return (-wnn * uft - wnt * need) * inv_det; };
+  const auto stick_normal = [&](T inv_det) FLOEDEM_LANES_LAMBDA { return (wtt * need + wnt * uft) * inv_det; };
+  const auto stick_holds = [&](T stick_pn, T stick_pt) FLOEDEM_LANES_LAMBDA {
     return Ops::both(Ops::less_equal(zero, stick_pn), Ops::less_equal(Ops::absolute(stick_pt), mu * stick_pn));
   };
   // Slide s: 1 / (W_nn - s mu W_nt), NaN where that is not positive (the slide never holds).
-  const auto slide_inverse = [&](T s) {
+  const auto slide_inverse = [&](T s) FLOEDEM_LANES_LAMBDA {
     const T divisor = wnn - s * mu * wnt;
     return Ops::select(Ops::less(zero, divisor), one / divisor, Ops::splat(std::numeric_limits<double>::quiet_NaN()));
   };
-  const auto slide_holds = [&](T s, T slide_pn) {
+  const auto slide_holds = [&](T s, T slide_pn) FLOEDEM_LANES_LAMBDA {
     const T slack = Ops::splat(-1e-14) * (Ops::absolute(uft) + Ops::absolute(need));
     return Ops::less_equal(slack, s * (uft + (wnt - s * mu * wtt) * slide_pn));
   };
