@@ -49,7 +49,7 @@ namespace floedem {
 
 namespace {
 // Every term floedem has, in the order they are added.
-constexpr ForceTermBuilder kTerms[] = {
+constexpr ForceTermBuilder kTermBuilders[] = {
     build_applied_load,  build_water_form_drag,  build_water_skin_drag, build_air_form_drag, build_air_skin_drag,
     build_coriolis,      build_sea_surface_tilt, build_wave_radiation,  build_rope_tow,
 };
@@ -90,7 +90,7 @@ double Forcing::drag_rate(const std::array<double, 9>& d, double mass, double in
 }
 
 Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(scene.run.dt) {
-  for (const ForceTermBuilder build : kTerms)
+  for (const ForceTermBuilder build : kTermBuilders)
     if (auto term = build(scene)) terms_.push_back(std::move(term));
   // The first run of consecutive drag terms (the four of a drifting field) shares a pass over
   // the floes they all act on; from then on those terms leave those floes to the pass.

@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// Two moving floes, a square and a triangle, 1 s at dt 0.01 s: a complete run's output.
-const std::string kScene = test::header_toml(1.0, 0.01, 0.3, 0.3) +
+const std::string kTwoFloes = test::header_toml(1.0, 0.01, 0.3, 0.3) +
                            test::body_toml({"a", test::box({5, 5}, 10, 10), {0.2, 0.0}}) +
                            test::body_toml({"b", {{20.5, 0}, {30.5, 0}, {20.5, 12}}, {}, 0.1});
 
@@ -138,10 +138,10 @@ const Damage kResumeDamage[] = {
      }},
 };
 
-/// The output of kScene, complete, at `path`; `duration` 50 s records 5000 frames, past the
+/// The output of kTwoFloes, complete, at `path`; `duration` 50 s records 5000 frames, past the
 /// first checkpoint (a full chunk of 4096 frames for two bodies).
 void write_run(const fs::path& dir, const std::string& path, double duration = 1.0) {
-  std::ofstream(dir / "run.toml") << kScene;
+  std::ofstream(dir / "run.toml") << kTwoFloes;
   REQUIRE(test::run_cli("run -q " + (dir / "run.toml").string() + " -o " + path + " --set run.duration=" +
                         std::to_string(duration)).code == 0);
 }

@@ -12,7 +12,7 @@ using test::BodyText;
 
 namespace {
 
-constexpr double kMass = 90000.0;  // 10 x 10 x 1 m at 900 kg/m^3
+constexpr double kBoxMass = 90000.0;  // 10 x 10 x 1 m at 900 kg/m^3
 
 const char* const kEngines[] = {"native", "box2d", "bullet", "ode"};
 
