@@ -118,6 +118,17 @@ inline std::string body_toml(const BodyText& b) {
   return o.str();
 }
 
+/// The push of the resting-contact tests (test_resting.cpp, test_sleep.cpp) on floe_and_wall's
+/// floe: F dt / m = 2.2e-3 m/s at dt 0.01 s.
+inline constexpr double kWallPush = 2e4;  // N
+
+/// A 10 x 10 m floe (body 0, centre (5, 5)) touching a fixed 2 x 40 m wall on its +x side
+/// (body 1), the floe under `floe_force`.
+inline std::string floe_and_wall(Vec2 floe_force = {}) {
+  return body_toml({"floe", box({5, 5}, 10, 10), {}, 0.0, false, floe_force}) +
+         body_toml({"wall", box({11, 5}, 2, 40), {}, 0.0, true});
+}
+
 inline std::string header_toml(double duration, double dt, double e, double mu, const std::string& extra = "") {
   std::ostringstream o;
   o.precision(17);

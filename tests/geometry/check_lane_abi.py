@@ -19,10 +19,7 @@ WIDE = ("double __vector(4)", "long __vector(4)", "double __vector(8)", "long __
 def own_parameters(name):
     """The parameter list of the function a demangled symbol names (not its enclosing scopes':
     a lambda's operator() inside a kernel that takes vectors names the kernel's too)."""
-    for suffix in (" [clone", ):
-        if suffix in name:
-            name = name[: name.index(suffix)]
-    name = name.rstrip()
+    name = name.split(" [clone", 1)[0].rstrip()  # GCC's clones: ".isra.0", ".constprop.0"
     for qualifier in (" const", " volatile", " &&", " &"):
         if name.endswith(qualifier):
             name = name[: -len(qualifier)].rstrip()

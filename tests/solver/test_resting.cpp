@@ -11,17 +11,9 @@
 using namespace floedem;
 using test::BodyText;
 
-namespace {
-
-constexpr double kPush = 2e4;  // N
-
-}  // namespace
-
 TEST_CASE("a floe pushed against a fixed wall: force equals the push, no jitter", "[resting]") {
   const double dt = 0.01;
-  const std::string text = test::header_toml(20.0, dt, 0.3, 0.3) +
-                           test::body_toml({"floe", test::box({5, 5}, 10, 10), {}, 0.0, false, {kPush, 0.0}}) +
-                           test::body_toml({"wall", test::box({11, 5}, 2, 40), {}, 0.0, true});
+  const std::string text = test::header_toml(20.0, dt, 0.3, 0.3) + test::floe_and_wall({test::kWallPush, 0.0});
   const Scene s = test::scene_from(text);
   Stepper run(s, "native");
   const Engine* e = &run.engine();
@@ -29,7 +21,7 @@ TEST_CASE("a floe pushed against a fixed wall: force equals the push, no jitter"
   for (int k = 0; k < 2000; ++k) {
     run.step();
     // The wall (body 1) is b: its contact force is +x; the floe's is -push.
-    worst_force = std::max(worst_force, std::abs(-test::contact_force_x(*e, 0, dt) - kPush) / kPush);
+    worst_force = std::max(worst_force, std::abs(-test::contact_force_x(*e, 0, dt) - test::kWallPush) / test::kWallPush);
     worst_speed = std::max(worst_speed, length(e->state().velocity[0]));
     worst_spin = std::max(worst_spin, std::abs(e->state().angular_velocity[0]) * 5.0);
   }
@@ -46,7 +38,7 @@ TEST_CASE("a floe pushed against a fixed wall: force equals the push, no jitter"
 TEST_CASE("a floe accelerated into a wall bounces, then comes to rest carrying the push", "[resting]") {
   const double dt = 0.01;
   const std::string text = test::header_toml(60.0, dt, 0.3, 0.3) +
-                           test::body_toml({"floe", test::box({4.95, 5}, 10, 10), {}, 0.0, false, {kPush, 0.0}}) +
+                           test::body_toml({"floe", test::box({4.95, 5}, 10, 10), {}, 0.0, false, {test::kWallPush, 0.0}}) +
                            test::body_toml({"wall", test::box({11, 5}, 2, 40), {}, 0.0, true});
   const Scene s = test::scene_from(text);
   Stepper run(s, "native");
@@ -58,7 +50,7 @@ TEST_CASE("a floe accelerated into a wall bounces, then comes to rest carrying t
     for (const auto& c : e->contacts()) collisions += c.kind == ContactKind::collision;
     max_overlap = std::max(max_overlap, e->state().position[0].x + 5.0 - 10.0);
     if (k >= 5000) {
-      CHECK(std::abs(-test::contact_force_x(*e, 0, dt) - kPush) <= 1e-3 * kPush);
+      CHECK(std::abs(-test::contact_force_x(*e, 0, dt) - test::kWallPush) <= 1e-3 * test::kWallPush);
       CHECK(length(e->state().velocity[0]) < 1e-9);
     }
   }

@@ -37,12 +37,8 @@ bool same_state(const BodyStates& a, const BodyStates& b) {
          same(a.angular_velocity, b.angular_velocity);
 }
 
-constexpr double kSleepPush = 2e4;  // N
-
 std::string pushed_floe(bool sleep) {
-  return test::header_toml(60.0, 0.01, 0.3, 0.3, sleep_settings(sleep)) +
-         test::body_toml({"floe", test::box({5, 5}, 10, 10)}) +
-         test::body_toml({"wall", test::box({11, 5}, 2, 40), {}, 0.0, true});
+  return test::header_toml(60.0, 0.01, 0.3, 0.3, sleep_settings(sleep)) + test::floe_and_wall();
 }
 
 }  // namespace
@@ -50,7 +46,7 @@ std::string pushed_floe(bool sleep) {
 TEST_CASE("sleep: a floe pushed on a wall sleeps carrying the push, and wakes when the push turns", "[sleep]") {
   const Scene s = test::scene_from(pushed_floe(true));
   auto e = test::native(s);
-  const Loads push = loads_on(2, 0, {kSleepPush, 0.0});
+  const Loads push = loads_on(2, 0, {test::kWallPush, 0.0});
   for (int k = 0; k < 1000; ++k) e->step(&push);  // 10 s: at rest within a step, asleep after 2 s more
   REQUIRE(asleep(*e) > 0.5);
   // Asleep: not moved, and the wall still carries the push (the held contact's impulses).
@@ -60,14 +56,14 @@ TEST_CASE("sleep: a floe pushed on a wall sleeps carrying the push, and wakes wh
     REQUIRE(e->state().position[0].x == at.x);
     REQUIRE(e->state().velocity[0].x == 0.0);
     // 0.1 %: the resting contact's tolerance (test_resting.cpp); held, it is the same impulse.
-    REQUIRE(std::abs(-test::contact_force_x(*e, 0, 0.01) - kSleepPush) <= 1e-3 * kSleepPush);
+    REQUIRE(std::abs(-test::contact_force_x(*e, 0, 0.01) - test::kWallPush) <= 1e-3 * test::kWallPush);
   }
   // The push turned: the floe wakes in the same step and leaves the wall at F dt / m.
-  const Loads pull = loads_on(2, 0, {-kSleepPush, 0.0});
+  const Loads pull = loads_on(2, 0, {-test::kWallPush, 0.0});
   e->step(&pull);
   CHECK(woken(*e) == 1);
   const double mass = 900.0 * 100.0;
-  CHECK(e->state().velocity[0].x == Approx(-kSleepPush * 0.01 / mass).epsilon(1e-12));
+  CHECK(e->state().velocity[0].x == Approx(-test::kWallPush * 0.01 / mass).epsilon(1e-12));
   CHECK(e->state().position[0].x < at.x);
 }
 
@@ -130,7 +126,7 @@ TEST_CASE("sleep: two floes in contact drifting under a small common load do not
 
 TEST_CASE("sleep: a checkpoint with sleeping bodies continues to the bit", "[sleep]") {
   const Scene s = test::scene_from(pushed_floe(true) + test::body_toml({"drifter", test::box({-15, 5}, 8, 8), {0.3, 0.0}}));
-  const Loads push = loads_on(3, 0, {kSleepPush, 0.0});
+  const Loads push = loads_on(3, 0, {test::kWallPush, 0.0});
   auto a = test::native(s);
   for (int k = 0; k < 800; ++k) a->step(&push);  // the floe asleep, the drifter on its way to it
   REQUIRE(asleep(*a) > 0.0);
@@ -151,7 +147,7 @@ TEST_CASE("sleep: a checkpoint with sleeping bodies continues to the bit", "[sle
 TEST_CASE("sleep: a scene switch turns it off", "[sleep]") {
   const Scene s = test::scene_from(pushed_floe(false));
   auto e = test::native(s);
-  const Loads push = loads_on(2, 0, {kSleepPush, 0.0});
+  const Loads push = loads_on(2, 0, {test::kWallPush, 0.0});
   for (int k = 0; k < 1000; ++k) e->step(&push);
   CHECK(asleep(*e) == 0.0);
   CHECK(e->info().settings.at("sleep") == "false");
