@@ -3,7 +3,8 @@
 # fresh build directory (CI): without these, the longest tests come in file order and start
 # near the end, while the other cores wait. Each COST is the test's seconds under the
 # sanitizers on 2 cores, where the order matters most; a rough figure is enough. ctest ignores a
-# name that matches no test: a renamed test must be renamed here too.
+# name that matches no test: a renamed test must be renamed here too, which the test "ctest: every
+# test that test_costs.cmake orders exists" (check_test_costs.cmake) holds.
 set(_floedem_slow_tests
   "every shipped scenario loads|120"
   "pair cache: every step the same pairs as a fresh broad phase|80"
