@@ -16,7 +16,10 @@
 
 namespace floedem {
 
-namespace {
+// Not in the anonymous namespace: Series is a member type of Recorder::Impl, which has external
+// linkage, and a unity build (scripts/test.sh) that batches this file with others would then
+// give Impl a field of internal linkage from another file than the batch's (-Wsubobject-linkage).
+namespace recorder_detail {
 
 /// A dataset that grows along its first dimension: [rows, shape...].
 class Series {
@@ -82,6 +85,12 @@ class Series {
   std::vector<hsize_t> row_shape_;
   hsize_t rows_ = 0;
 };
+
+}  // namespace recorder_detail
+
+using recorder_detail::Series;
+
+namespace {
 
 H5::DSetCreatPropList fixed_plist() {
   H5::DSetCreatPropList plist;

@@ -18,7 +18,7 @@ namespace {
 // Manifolds ahead whose first line is asked for before it is read: the loop reads 8 bytes of
 // each 384-byte manifold, out of cache at 16k floes, and waited for each (perf: a third of the
 // build's samples on that load). A prefetch changes no value.
-constexpr std::size_t kAhead = 8;
+constexpr std::size_t kManifoldsAhead = 8;
 }  // namespace
 
 void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays& bodies) {
@@ -42,7 +42,7 @@ void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays
   const std::size_t nm = manifolds.size();
   resize_with_headroom(manifold_island_, nm);
   for (std::size_t k = 0; k < nm; ++k) {
-    if (k + kAhead < nm) __builtin_prefetch(&manifolds[k + kAhead].body_a);
+    if (k + kManifoldsAhead < nm) __builtin_prefetch(&manifolds[k + kManifoldsAhead].body_a);
     const Manifold& m = manifolds[k];
     const bool ma = moving(m.body_a), mb = moving(m.body_b);
     manifold_island_[k] = ma ? m.body_a : mb ? m.body_b : -1;
