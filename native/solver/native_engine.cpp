@@ -81,6 +81,13 @@ class NativeEngine final : public Engine {
   void pair_up();  // parts placed at the bodies' positions (unchanged within a step)
   bool outran_reach();
   bool meets_unseen_contact();
+  // The step's contacts found and solved again where outran_list_'s bodies widened their reach:
+  // only the islands they can touch are solved again, the rest keep their solution.
+  void redetect();
+  void mark_for_resolve(std::int32_t body);
+  bool touches_sleeper() const;  // whether wake_touched would wake a group
+  bool unmarked_contacts_held() const;
+  void keep_solved_contacts();
   // The narrow phase: each pair's manifold into narrow_; `redetection`: that of a step found
   // again (every part where the step's first narrow phase had it).
   void collide_pairs(bool redetection);
@@ -145,6 +152,15 @@ class NativeEngine final : public Engine {
   std::vector<std::uint8_t> outran_;       // per body: its impulses sent it beyond its reach this step
   std::vector<std::int32_t> outran_list_;  // ... those bodies
   std::vector<std::int32_t> near_;         // parts near an outrun part's widened box
+  // A redetection's reach (redetect()): per body, its island at the last solve (-1: none) and
+  // whether it is in an island solved again (those bodies listed); per island of the last
+  // solve, whether it is; the contact list as last solved, kept for the islands not solved again.
+  std::vector<std::int32_t> body_island_;
+  std::vector<std::uint8_t> resolve_;
+  std::vector<std::int32_t> resolve_list_;
+  std::vector<std::uint8_t> island_resolved_;
+  bool partial_solve_ = false;             // solve_contacts solves only the islands of resolve_
+  LineVector<Manifold> solved_;
   LineVector<Aabb> part_boxes_;
   std::vector<double> part_margin_;        // per part: room of its fat box in the pair cache
   PairCache pair_cache_;
@@ -287,6 +303,8 @@ NativeEngine::NativeEngine(const Scene& scene)
   part_reach_.resize(parts_.size());
   part_margin_.resize(parts_.size());
   outran_.assign(n, 0);
+  body_island_.assign(n, -1);
+  resolve_.assign(n, 0);
   forget_narrow();
 }
 
@@ -469,21 +487,18 @@ void NativeEngine::step(const Loads* loads) {
     // (a floe struck at 5 m/s crosses a 5 cm gap to the next in one 0.01 s step), or reach a
     // point of a pair that was beyond the margin (a floe spun by a collision swings its far
     // corner into its neighbour): where the widened reach shows such a contact, the step's
-    // contacts are found again and solved again from the velocities after the loads
-    // (classified on those: the only difference from a first pass).
+    // contacts are found again, and the islands that the widened reaches can touch solved
+    // again (redetect()).
     stages_.time(kRedetect, [&] {
-      for (int pass = 0; settings_.redetect && pass < kMaxRedetections && outran_reach() && meets_unseen_contact();
-           ++pass) {
-        // The accumulated impulses are all that the solve applied (warm start included; a cold
-        // restart or a direct solve reset them with the velocities): taken off, the velocities
-        // are those after the loads, to rounding.
-        apply_accumulated_impulses(manifolds_, bodies_, -1.0);
-        pair_up();
-        collide_pairs(/*redetection=*/true);
-        if (asleep_count_ > 0) wake_touched();  // a body struck into a sleeping one wakes it (with its loads)
-        build_contact_list();
-        solve_contacts();
-        ++redetections_;
+      for (int pass = 0; settings_.redetect && pass < kMaxRedetections && outran_reach(); ++pass) {
+        const bool unseen = meets_unseen_contact();
+        if (unseen) {
+          redetect();
+          ++redetections_;
+        }
+        for (const std::int32_t b : outran_list_) outran_[b] = 0;
+        outran_list_.clear();
+        if (!unseen) break;
       }
     });
   }
@@ -558,9 +573,128 @@ bool NativeEngine::meets_unseen_contact() {
       }
     }
   }
-  for (const std::int32_t b : outran_list_) outran_[b] = 0;
-  outran_list_.clear();
   return unseen;
+}
+
+void NativeEngine::redetect() {
+  // Which contacts can change: those of a part whose reach grew (the bodies of outran_list_).
+  // Every other pair keeps its parts' reaches, so the narrow phase gives it the manifold it had
+  // (collide_pairs), and a new contact has a body of outran_list_ at one end. So the islands
+  // of the last solve that hold such a body, or a body within its widened reach, are all that
+  // can change: they are marked, their impulses taken off, and they are solved again from the
+  // velocities after the loads (classified on those: the only difference from a first pass).
+  // Every other island keeps its solution to the bit. Solved again, it would be classified on
+  // the velocities after the loads too, where a floe pressed on a wall by its load approaches
+  // it at F dt / m: a collision, not a resting contact, and with restitution it would bounce
+  // off because a floe was struck a kilometre away (test_impacts.cpp). Marking is closed: a new
+  // island is the union of marked islands joined by new contacts, or an old island untouched.
+  const std::size_t ni = islands_.size();
+  for (std::size_t i = 0; i < ni; ++i)
+    for (const std::int32_t b : islands_.bodies(i)) body_island_[b] = static_cast<std::int32_t>(i);
+  island_resolved_.assign(ni, 0);
+  auto grown = [&](std::int32_t k) { return reach_box(k, reach_of_part(k)); };
+  for (const std::int32_t body : outran_list_) {
+    mark_for_resolve(body);
+    // The parts within the widened reach, as the pairs will find them (reach boxes overlapping).
+    for (std::int32_t k = parts_.first_part(body); k < parts_.first_part(body + 1); ++k) {
+      const Aabb box = grown(k);
+      pair_cache_.parts_near(box, near_);
+      for (const std::int32_t j : near_)
+        if (grown(j).overlaps(box)) mark_for_resolve(parts_.body()[j]);
+    }
+  }
+  // The accumulated impulses are all that the solve applied (warm start included; a cold
+  // restart or a direct solve reset them with the velocities): taken off, the velocities are
+  // those after the loads, to rounding. Island by island: each body sees its manifolds in
+  // their order in the list, as one pass over the list would apply them.
+  auto take_off = [&](std::size_t i) {
+    for (const std::int32_t k : islands_.manifolds(i))
+      apply_accumulated_impulses({&manifolds_[static_cast<std::size_t>(k)], 1}, bodies_, -1.0);
+  };
+  for (std::size_t i = 0; i < ni; ++i)
+    if (island_resolved_[i]) take_off(i);
+  pair_up();
+  collide_pairs(/*redetection=*/true);
+  // A body struck into a sleeping one wakes its group (with its loads), which joins islands
+  // that were not marked: then every island is solved again (rare: the sleepers are far from
+  // the floes that strike). Taken off before the wake: a sleeping body held, as in the solve.
+  // The same where the unmarked contacts are not the last solve's (the argument above says they
+  // are; checked, since a kept island with a contact more or less would be wrong).
+  const bool all = (asleep_count_ > 0 && touches_sleeper()) || !unmarked_contacts_held();
+  if (all) {
+    for (std::size_t i = 0; i < ni; ++i)
+      if (!island_resolved_[i]) take_off(i);
+    if (asleep_count_ > 0) wake_touched();
+  }
+  for (std::size_t i = 0; i < ni; ++i)
+    for (const std::int32_t b : islands_.bodies(i)) body_island_[b] = -1;
+  if (!all) std::swap(manifolds_, solved_);  // the solved list kept, the new one built over the old
+  build_contact_list();
+  if (!all) keep_solved_contacts();
+  partial_solve_ = !all;
+  solve_contacts();
+  partial_solve_ = false;
+  for (const std::int32_t b : resolve_list_) resolve_[b] = 0;
+  resolve_list_.clear();
+}
+
+void NativeEngine::mark_for_resolve(std::int32_t body) {
+  // Only a moving body is marked: a fixed, towed or sleeping one joins no island (an impulse
+  // cannot change its velocity), and its contacts go with the moving body at their other end.
+  if (bodies_.inv_mass[body] == 0.0) return;
+  const std::int32_t i = body_island_[body];
+  if (i < 0) {
+    if (!resolve_[body]) resolve_list_.push_back(body);
+    resolve_[body] = 1;
+    return;
+  }
+  if (island_resolved_[i]) return;
+  island_resolved_[i] = 1;
+  for (const std::int32_t b : islands_.bodies(static_cast<std::size_t>(i))) {
+    resolve_[b] = 1;
+    resolve_list_.push_back(b);
+  }
+}
+
+bool NativeEngine::unmarked_contacts_held() const {
+  // The new pairs with contact points and no marked body, against the last solve's manifolds
+  // with no marked body: the same pairs, in the same order (both sorted by pair).
+  auto unmarked = [&](std::int32_t a, std::int32_t b) { return !resolve_[a] && !resolve_[b]; };
+  std::size_t old = 0;
+  auto next_old = [&] {
+    while (old < manifolds_.size() && !unmarked(manifolds_[old].body_a, manifolds_[old].body_b)) ++old;
+  };
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    if (narrow_points_[k] == 0) continue;
+    const PartPair pair = pairs_[k];
+    if (!unmarked(parts_.body()[pair.a], parts_.body()[pair.b])) continue;
+    next_old();
+    if (old == manifolds_.size() || manifolds_[old].part_a != pair.a || manifolds_[old].part_b != pair.b) return false;
+    ++old;
+  }
+  next_old();
+  return old == manifolds_.size();
+}
+
+void NativeEngine::keep_solved_contacts() {
+  // A contact of two unmarked bodies is the one the last solve left (unmarked_contacts_held):
+  // its impulses, its classification on the velocities before the step, and its bodies'
+  // velocities stay.
+  std::size_t old = 0;
+  for (Manifold& m : manifolds_) {
+    if (resolve_[m.body_a] || resolve_[m.body_b]) continue;
+    while (solved_[old].part_a != m.part_a || solved_[old].part_b != m.part_b) ++old;
+    m = solved_[old++];
+  }
+}
+
+bool NativeEngine::touches_sleeper() const {
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    if (narrow_points_[k] == 0) continue;
+    const std::int32_t a = parts_.body()[pairs_[k].a], b = parts_.body()[pairs_[k].b];
+    if (asleep(a) != asleep(b) && moves_[asleep(a) ? b : a]) return true;
+  }
+  return false;
 }
 
 void NativeEngine::find_pairs(const Loads* loads) {
@@ -789,6 +923,8 @@ void NativeEngine::solve_contacts() {
   // apply_impulse), and each is solved the same way on any thread, so the result does not
   // depend on the thread count.
   const std::size_t n = islands_.size();
+  // A redetection solves only the islands it marked (redetect()); an island is marked whole.
+  auto kept = [&](std::size_t i) { return partial_solve_ && !resolve_[islands_.bodies(i)[0]]; };
   const std::size_t blocks = std::max<std::size_t>(1, (n + kIslandGrain - 1) / kIslandGrain);
   if (island_work_.size() < blocks) island_work_.resize(blocks + blocks / 2);
   bool any_coloured = false;
@@ -803,7 +939,7 @@ void NativeEngine::solve_contacts() {
     island_bundles_[0] = 0;
     for (std::size_t i = 0; i < n; ++i) {
       island_bundles_[i + 1] = island_bundles_[i];
-      if (!coloured(i)) continue;
+      if (!coloured(i) || kept(i)) continue;
       const SweepSpace space = sweep_work_.slice(islands_.manifold_offset(i), islands_.manifolds(i).size());
       island_bundles_[i + 1] += colour_manifolds(manifolds_, islands_.manifolds(i), bodies_, space.overflow,
                                                  space.body_colours);
@@ -826,10 +962,10 @@ void NativeEngine::solve_contacts() {
   thread_pool().for_blocks(n, kIslandGrain, [&](std::size_t begin, std::size_t end) {
     IslandWork& w = island_work_[begin / kIslandGrain];
     for (std::size_t i = begin; i < end; ++i)
-      if (!large(i)) w.longest = std::max(w.longest, solve_island(i, checked, w, false));
+      if (!large(i) && !kept(i)) w.longest = std::max(w.longest, solve_island(i, checked, w, false));
   });
   for (std::size_t i = 0; threads && i < n; ++i)
-    if (large(i)) {
+    if (large(i) && !kept(i)) {
       IslandWork& w = island_work_[i / kIslandGrain];
       w.longest = std::max(w.longest, solve_island(i, checked, w, true));
     }
@@ -839,11 +975,13 @@ void NativeEngine::solve_contacts() {
     cold_restarts_ += w.cold_restarts;
   }
   total_sweeps_ += longest;
-  total_islands_ += static_cast<std::int64_t>(n);
+  for (std::size_t i = 0; i < n; ++i) total_islands_ += !kept(i);
   // Out of sweeps: an island Gauss-Seidel cannot hold (heavy-light chains) gets its normal
   // impulses solved directly. Below a mass ratio of a few hundred the sweeps hold a chain
   // (measured in the stress suite: 0.5 mm at 1e2 with 50 sweeps, 5 mm at 1e3), and a scene
-  // without such a ratio between any two moving bodies never looks (heavy_light_).
+  // without such a ratio between any two moving bodies never looks (heavy_light_). It looks at
+  // every island, those a redetection kept too: one that the step's first pass left out of
+  // sweeps was solved directly then, unless that would have made energy, and may be tried again.
   if (heavy_light_ && longest >= settings_.velocity_iterations) solve_islands_directly(before);
 }
 

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 
 #include "geometry/sat.hpp"
+#include "run/stepper.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -287,6 +288,66 @@ TEST_CASE("redetect: a floe struck across a gap within one step meets the next o
   };
   CHECK(overlap_after(true) <= 1e-3 + 1e-9);
   CHECK(overlap_after(false) > 1e-2);
+}
+
+TEST_CASE("redetect: the islands the widened reach cannot touch are not solved again", "[impacts]") {
+  // As in the test above, a floe struck across its 5 cm gap within one step, here onto a fixed
+  // wall; 1 km along that wall, five floes pushed against it and sliding along it, each its own
+  // island (a fixed body joins none), solved in every step.
+  // In a step where the struck floe is found again, only its own island is solved again: the
+  // far floes' islands are solved once a step, and their paths and contact impulses are the
+  // same to the bit with redetect on and off.
+  constexpr int kSteps = 10, kFar = 5;
+  struct Run {
+    std::vector<double> far_path;
+    double islands = 0.0, redetections = 0.0;
+  };
+  auto run = [](bool redetect, bool row, bool far) {
+    std::string text =
+        test::header_toml(0.2, 0.02, 1.0, 0.3,
+                          std::string("[engine.native]\nredetect = ") + (redetect ? "true" : "false") + "\n");
+    // Left out, the struck pair is fixed and still (the bodies keep their numbers).
+    text += test::body_toml({"a", test::box({-10.05, 0}, 10, 10), {row ? 5.0 : 0.0, 0}, 0.0, !row}) +
+            test::body_toml({"b", test::box({0, 0}, 10, 10), {}, 0.0, !row}) +
+            test::body_toml({"wall", test::box({6.05, 550}, 2, 1200), {}, 0.0, true});
+    for (int i = 0; far && i < kFar; ++i)
+      text += test::body_toml({"far" + std::to_string(i), test::box({0.05, 1000.0 + 50.0 * i}, 10, 10),
+                               {0, 0.1137 * (i + 1)}, 0.0, false, {2.7e4, 1.9e4 * (i + 1)}});
+    const Scene scene = test::scene_from(text);
+    Stepper stepper(scene, "native");  // with the pushes (forcing)
+    const Engine* e = &stepper.engine();
+    Run r;
+    for (int k = 0; k < kSteps; ++k) {
+      stepper.step();
+      const BodyStates& b = e->state();
+      for (std::size_t i = 3; far && i < 3 + kFar; ++i)
+        r.far_path.insert(r.far_path.end(), {b.position[i].x, b.position[i].y, b.angle[i], b.velocity[i].x,
+                                             b.velocity[i].y, b.angular_velocity[i]});
+      // ... and their contacts' impulses, which the next step starts from.
+      for (const ContactRecord& c : e->contacts())
+        if (std::max(c.body_a, c.body_b) >= 3)
+          r.far_path.insert(r.far_path.end(), {c.normal_impulse, c.tangent_impulse, static_cast<double>(c.kind)});
+    }
+    std::vector<WorkCount> work;
+    e->add_work_counts(work);
+    for (const WorkCount& w : work) {
+      if (w.name == "islands") r.islands = w.count;
+      if (w.name == "redetections") r.redetections = w.count;
+    }
+    return r;
+  };
+  const Run with = run(true, true, true), row_alone = run(true, true, false), far_alone = run(true, false, true),
+            without = run(false, true, true);
+  REQUIRE(with.redetections > 0);
+  CHECK(row_alone.redetections == with.redetections);
+  CHECK(far_alone.redetections == 0);
+  // The far floes' islands are solved as often as without the row: in no redetection.
+  REQUIRE(far_alone.islands >= kSteps);
+  CHECK(with.islands == row_alone.islands + far_alone.islands);
+  REQUIRE(with.far_path.size() == without.far_path.size());
+  bool same = true;
+  for (std::size_t i = 0; i < with.far_path.size(); ++i) same = same && same_bits(with.far_path[i], without.far_path[i]);
+  CHECK(same);
 }
 
 TEST_CASE("a floe sliding corner-first onto another's face is met, not overlapped", "[impacts]") {
