@@ -204,6 +204,9 @@ struct CellSet {
   std::vector<double> area;
   std::vector<Vec2> centroid;
   std::vector<Eigen::Triplet<double>> hessian;
+  // Each block's matrix entries before they are joined (compute_cells): kept between passes,
+  // so that the Newton steps' passes do not each take some 40 MB anew at 10^5 floes.
+  std::vector<std::vector<Eigen::Triplet<double>>> block_entries;
 };
 
 void cell_block(const std::vector<Vec2>& sites, const std::vector<double>& w, const Domain& domain,
@@ -222,7 +225,9 @@ void compute_cells(const std::vector<Vec2>& sites, const std::vector<double>& w,
   // matrix entries, joined in block order, spread over the worker threads. The entries come
   // out in site order whatever the thread count, so the field does not depend on it.
   const std::size_t blocks = std::clamp<std::size_t>(n / 2048, 1, 64);
-  std::vector<std::vector<Eigen::Triplet<double>>> entries(blocks);
+  std::vector<std::vector<Eigen::Triplet<double>>>& entries = out.block_entries;
+  entries.resize(blocks);
+  for (auto& e : entries) e.clear();
   std::atomic<std::size_t> next{0};
   auto work = [&] {
     for (std::size_t part; (part = next.fetch_add(1)) < blocks;)
