@@ -80,6 +80,11 @@ class NativeEngine final : public Engine {
   bool set_reach(std::size_t body, const Loads* loads);  // ... one body's; whether it changed
   void pair_up();  // parts placed at the bodies' positions (unchanged within a step)
   bool outran_reach();
+  // Each part of a body of outran_list_ against each part whose box at the present reaches
+  // overlaps its own (the pairs that a broad phase at those reaches finds), until visit(k, j),
+  // k the outrun part, returns true; whether one did.
+  template <class Visit>
+  bool visit_parts_near_outrun(Visit&& visit);
   bool meets_unseen_contact();
   // The step's contacts found and solved again where outran_list_'s bodies widened their reach:
   // only the islands they can touch are solved again, the rest keep their solution.
@@ -545,35 +550,38 @@ bool NativeEngine::meets_unseen_contact() {
   // again. The rest cost a box query and a narrow phase each (towing: most floes the iceberg
   // strikes outrun the reach of a floe at rest, and meet nothing new within the step).
   const double slop = 0.5 * settings_.allowed_penetration;
-  auto grown = [&](std::int32_t k) { return reach_box(k, reach_of_part(k)); };
-  bool unseen = false;
   NarrowManifold probe;
-  for (std::size_t x = 0; x < outran_list_.size() && !unseen; ++x) {
-    const std::int32_t body = outran_list_[x];
-    for (std::int32_t k = parts_.first_part(body); k < parts_.first_part(body + 1) && !unseen; ++k) {
+  return visit_parts_near_outrun([&](std::int32_t k, std::int32_t j) {
+    const std::int32_t a = parts_.body()[std::min(j, k)], b = parts_.body()[std::max(j, k)];
+    if (a == b || (parts_.immovable()[j] && parts_.immovable()[k])) return false;
+    const PartPair pair{std::min(j, k), std::max(j, k)};
+    collide_parts(pair, reach_of_part(pair.a), reach_of_part(pair.b), probe);
+    if (probe.point_count == 0) return false;
+    const auto held = find_pair(manifolds_, pair);
+    const bool pair_held = held != manifolds_.end() && held->part_a == pair.a && held->part_b == pair.b;
+    for (int q = 0; q < probe.point_count; ++q) {
+      const NarrowPoint& p = probe.points[q];
+      bool point_held = false;
+      for (int h = 0; pair_held && h < held->point_count; ++h) point_held = point_held || held->points[h].id == p.id;
+      if (point_held) continue;
+      const Vec2 u = relative_velocity(bodies_, a, b, p.point - bodies_.position[a], p.point - bodies_.position[b]);
+      if (p.separation + dt_ * dot(u, probe.normal) < -slop) return true;
+    }
+    return false;
+  });
+}
+
+template <class Visit>
+bool NativeEngine::visit_parts_near_outrun(Visit&& visit) {
+  auto grown = [&](std::int32_t k) { return reach_box(k, reach_of_part(k)); };
+  for (const std::int32_t body : outran_list_)
+    for (std::int32_t k = parts_.first_part(body); k < parts_.first_part(body + 1); ++k) {
       const Aabb box = grown(k);
       pair_cache_.parts_near(box, near_);
-      for (const std::int32_t j : near_) {
-        const std::int32_t a = parts_.body()[std::min(j, k)], b = parts_.body()[std::max(j, k)];
-        if (a == b || (parts_.immovable()[j] && parts_.immovable()[k]) || !grown(j).overlaps(box)) continue;
-        const PartPair pair{std::min(j, k), std::max(j, k)};
-        collide_parts(pair, reach_of_part(pair.a), reach_of_part(pair.b), probe);
-        if (probe.point_count == 0) continue;
-        const auto held = find_pair(manifolds_, pair);
-        const bool pair_held = held != manifolds_.end() && held->part_a == pair.a && held->part_b == pair.b;
-        for (int q = 0; q < probe.point_count && !unseen; ++q) {
-          const NarrowPoint& p = probe.points[q];
-          bool point_held = false;
-          for (int h = 0; pair_held && h < held->point_count; ++h) point_held = point_held || held->points[h].id == p.id;
-          if (point_held) continue;
-          const Vec2 u = relative_velocity(bodies_, a, b, p.point - bodies_.position[a], p.point - bodies_.position[b]);
-          unseen = p.separation + dt_ * dot(u, probe.normal) < -slop;
-        }
-        if (unseen) break;
-      }
+      for (const std::int32_t j : near_)
+        if (grown(j).overlaps(box) && visit(k, j)) return true;
     }
-  }
-  return unseen;
+  return false;
 }
 
 void NativeEngine::redetect() {
@@ -592,17 +600,11 @@ void NativeEngine::redetect() {
   for (std::size_t i = 0; i < ni; ++i)
     for (const std::int32_t b : islands_.bodies(i)) body_island_[b] = static_cast<std::int32_t>(i);
   island_resolved_.assign(ni, 0);
-  auto grown = [&](std::int32_t k) { return reach_box(k, reach_of_part(k)); };
-  for (const std::int32_t body : outran_list_) {
-    mark_for_resolve(body);
-    // The parts within the widened reach, as the pairs will find them (reach boxes overlapping).
-    for (std::int32_t k = parts_.first_part(body); k < parts_.first_part(body + 1); ++k) {
-      const Aabb box = grown(k);
-      pair_cache_.parts_near(box, near_);
-      for (const std::int32_t j : near_)
-        if (grown(j).overlaps(box)) mark_for_resolve(parts_.body()[j]);
-    }
-  }
+  for (const std::int32_t body : outran_list_) mark_for_resolve(body);
+  visit_parts_near_outrun([&](std::int32_t, std::int32_t j) {
+    mark_for_resolve(parts_.body()[j]);
+    return false;
+  });
   // The accumulated impulses are all that the solve applied (warm start included; a cold
   // restart or a direct solve reset them with the velocities): taken off, the velocities are
   // those after the loads, to rounding. Island by island: each body sees its manifolds in
@@ -975,7 +977,11 @@ void NativeEngine::solve_contacts() {
     cold_restarts_ += w.cold_restarts;
   }
   total_sweeps_ += longest;
-  for (std::size_t i = 0; i < n; ++i) total_islands_ += !kept(i);
+  std::size_t solved = n;  // a redetection counts the islands it solved again
+  if (partial_solve_)
+    for (std::size_t i = 0; i < n; ++i) solved -= kept(i);
+  total_islands_ += static_cast<std::int64_t>(solved);
+
   // Out of sweeps: an island Gauss-Seidel cannot hold (heavy-light chains) gets its normal
   // impulses solved directly. Below a mass ratio of a few hundred the sweeps hold a chain
   // (measured in the stress suite: 0.5 mm at 1e2 with 50 sweeps, 5 mm at 1e3), and a scene
