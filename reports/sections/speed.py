@@ -364,8 +364,9 @@ def stages_scaling(small, large, setting):
                                   "contacts is within 1.5 times the allowed overlap, so one deep contact anywhere "
                                   "keeps the projection sweeping (each later sweep measures only the contacts "
                                   "whose floes moved, but the first measures every contact)",
-           "redetect": "redetect finds and solves all of the step's contacts again when any body the impulses "
-                       "sent beyond its reach meets a contact the step did not hold"}
+           "redetect": "redetect finds the step's contacts again, and solves again the islands the widened "
+                       "reach can touch, when any body the impulses sent beyond its reach meets a contact the "
+                       "step did not hold; in a packed field the struck floe's island is nearly the whole field"}
     reasons = [why[k] for k, _ in grown if k in why]
     if reasons:
         text += " Of these, " + "; ".join(reasons) + ": the larger the field, the likelier such a cause somewhere."
