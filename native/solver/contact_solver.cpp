@@ -45,7 +45,7 @@ LocalImpulse solve_single_contact(double ufn, double uft, double target, double 
   return r;
 }
 
-void prepare_contact(Manifold& m, const BodyArrays& s, double dt, double collision_threshold) {
+void prepare_contact(Manifold& m, const BodyArrays& s, double dt, double collision_threshold, const Manifold* held) {
   const int a = m.body_a, b = m.body_b;
   const Vec2 n = m.normal;
   const double ma = s.inv_mass[a], mb = s.inv_mass[b];
@@ -59,6 +59,10 @@ void prepare_contact(Manifold& m, const BodyArrays& s, double dt, double collisi
     p.wnt = w.wnt;
     p.wtt = w.wtt;
     p.approach_velocity = dot(relative_velocity(s, a, b, p.ra, p.rb), n);
+    // Found again in a redetection, the velocities are those after the loads: a floe pressed on
+    // a wall by its load approaches it at F dt / m there, and would be taken for a collision.
+    for (int j = 0; held && j < held->point_count; ++j)
+      if (held->points[j].id == p.id) p.approach_velocity = held->points[j].approach_velocity;
     const double gap = std::max(p.separation, 0.0);
     // A collision: a new contact, approaching faster than the threshold, reached within the
     // step. A point that was pressed last step is resting whatever its approach speed: bodies

@@ -46,7 +46,11 @@ template <class T>
 /// Classifies each point of m (collision or resting) from its approach velocity and gap, sets
 /// its target normal velocity, and fills the Delassus block. A collision's impulses start from
 /// zero (Newton's law fixes them; a warm start's guess would be a resting impulse's).
-void prepare_contact(Manifold& m, const BodyArrays& bodies, double dt, double collision_threshold);
+/// `held`: the same pair's manifold as the step's first pass classified it, when the step's
+/// contacts are found again (a redetection); a point it holds keeps the approach velocity it
+/// was classified on there, measured before the loads, so it is classified as it was.
+void prepare_contact(Manifold& m, const BodyArrays& bodies, double dt, double collision_threshold,
+                     const Manifold* held = nullptr);
 
 /// Applies `impulse` (on b; its opposite on a) at the contact point of lever arms ra, rb. A
 /// fixed or prescribed body (inv_mass = inv_inertia = 0) keeps its given velocity and is not

