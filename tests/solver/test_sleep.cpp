@@ -91,6 +91,44 @@ TEST_CASE("sleep: a floe struck by a moving one wakes, and the impact is the sam
   CHECK(a->state().velocity[0].x < 0.0);
 }
 
+TEST_CASE("sleep: a floe struck across a gap into a sleeping one within a step wakes it, as without sleeping",
+          "[sleep][impacts]") {
+  // Three floes in a row, 5 cm apart; the middle and the last at rest fall asleep, and the first
+  // comes in at 5 m/s, e = 1. It wakes the middle one, which leaves at 5 m/s and crosses its gap
+  // to the last within the same 0.02 s step: the step's contacts are found again with its reach
+  // widened, and there a woken body meets a sleeping one, so every island is solved again with
+  // the last floe awake. The sleepers were at rest with no load, so the run must be the one
+  // without sleeping to the bit, whose redetection solves only the islands it can touch.
+  auto scene = [](bool sleep) {
+    return test::scene_from(test::header_toml(1.0, 0.02, 1.0, 0.0, sleep_settings(sleep, 0.04)) +
+                            test::body_toml({"a", test::box({-10.55, 0}, 10, 10), {5.0, 0}}) +
+                            test::body_toml({"b", test::box({0, 0}, 10, 10)}) +
+                            test::body_toml({"c", test::box({10.05, 0}, 10, 10)}));
+  };
+  const Scene on = scene(true), off = scene(false);
+  auto a = test::native(on);
+  auto b = test::native(off);
+  double deepest = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    a->step(nullptr);
+    b->step(nullptr);
+    REQUIRE(same_state(a->state(), b->state()));
+    for (const ContactRecord& c : a->contacts()) deepest = std::max(deepest, -c.separation);
+  }
+  std::vector<WorkCount> work;
+  a->add_work_counts(work);
+  double redetections = 0.0;
+  for (const WorkCount& w : work)
+    if (w.name == "redetections") redetections = w.count;
+  CHECK(redetections >= 1.0);
+  CHECK(woken(*a) >= 2);             // the middle floe, then the last
+  // The last floe was struck, and momentum kept (equal masses, no drag in this scene).
+  const std::vector<Vec2>& v = a->state().velocity;
+  CHECK(v[2].x > 1.0);
+  CHECK(v[0].x + v[1].x + v[2].x == Approx(5.0).epsilon(1e-12));
+  CHECK(deepest <= 1e-3 + 1e-9);
+}
+
 TEST_CASE("sleep: a free floe under a load too small for the timer does not sleep", "[sleep]") {
   // 1e-8 m/s^2 keeps the floe under sleep_speed (1e-5 m/s) for 1 000 s, far past sleep_time:
   // the balance test (a body without contacts needs no load) keeps it awake.
