@@ -18,6 +18,7 @@
 #include "solver/coloured_sweeps.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/pressed_pack.hpp"
+#include "support.hpp"
 
 using namespace floedem;
 using namespace floedem::test;
@@ -258,6 +259,41 @@ TEST_CASE("coloured sweeps: the native engine gives the same state on 1 and 2 th
     Stepper stepper(scene, "native");
     for (int k = 0; k < kSteps; ++k) stepper.step();
     states[threads - 1] = stepper.state();
+  }
+  set_thread_pool_size(worker_threads());
+  check_same_state(states[0], states[1]);
+}
+
+TEST_CASE("coloured sweeps: an island solved on every thread at once gives the same state on 1 and 2 threads",
+          "[solver][coloured][threads]") {
+  // An island of at least kColouredOnThreads manifolds is left out of the blocks of islands and
+  // solved after them, its colours swept on the pool (NativeEngine::solve_contacts), the path
+  // of a packed field on its wall; the fields of the tests above do not pack into one that
+  // large within their steps. Here 50 x 50 floes of 10 m, each touching its neighbours (4 900
+  // manifolds, one island), closing on the middle (0.2 m/s at the edges, neighbours 8 mm/s
+  // apart) with random velocities of up to 0.05 m/s on top: collisions, pressed contacts,
+  // sticking and sliding from the first step.
+  constexpr int kSide = 50, kSteps = 20;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::string text = header_toml(1.0, 0.05, 0.1, 0.3);
+  for (int r = 0; r < kSide; ++r)
+    for (int c = 0; c < kSide; ++c)
+      text += body_toml({"floe-" + std::to_string(r * kSide + c), box({10.0 * c, 10.0 * r}, 10, 10),
+                         Vec2{245.0 - 10.0 * c, 245.0 - 10.0 * r} * (0.2 / 245.0) + Vec2{0.05 * u(rng), 0.05 * u(rng)},
+                         0.002 * u(rng)});
+  const Scene scene = scene_from(text);
+  BodyStates states[2];
+  for (const unsigned threads : {1u, 2u}) {
+    set_thread_pool_size(threads);
+    auto e = native(scene);
+    e->step(nullptr);
+    // The path asked for: one island a step, of more manifolds than kColouredOnThreads (a
+    // manifold records at most two points).
+    REQUIRE(e->contacts().size() > 2 * kColouredOnThreads);
+    for (int k = 1; k < kSteps; ++k) e->step(nullptr);
+    REQUIRE(e->info().settings.at("mean_islands_per_step") == "1");
+    states[threads - 1] = e->state();
   }
   set_thread_pool_size(worker_threads());
   check_same_state(states[0], states[1]);
