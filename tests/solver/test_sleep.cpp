@@ -129,6 +129,43 @@ TEST_CASE("sleep: a floe struck across a gap into a sleeping one within a step w
   CHECK(deepest <= 1e-3 + 1e-9);
 }
 
+TEST_CASE("sleep: a floe woken by a redetection after the loads gets its own load", "[sleep][impacts]") {
+  // As above, but the last floe is pushed by its load onto a fixed wall beyond it and sleeps
+  // carrying the push. Woken by the redetection, after the step's loads were applied, it gets
+  // its load then (wake_group): the wall's reaction in the strike's step and the floes' paths
+  // are those of the run without sleeping, to the solve's tolerance. Without it the wall would
+  // miss the push's impulse, F dt = 400 N s, in that step.
+  auto scene = [](bool sleep) {
+    return test::scene_from(test::header_toml(1.0, 0.02, 1.0, 0.0, sleep_settings(sleep, 0.04)) +
+                            test::body_toml({"a", test::box({-10.55, 0}, 10, 10), {5.0, 0}}) +
+                            test::body_toml({"b", test::box({0, 0}, 10, 10)}) +
+                            test::body_toml({"c", test::box({10.05, 0}, 10, 10)}) +
+                            test::body_toml({"wall", test::box({16.05, 0}, 2, 40), {}, 0.0, true}));
+  };
+  const Scene on = scene(true), off = scene(false);
+  auto a = test::native(on);
+  auto b = test::native(off);
+  const Loads push = loads_on(4, 2, {test::kWallPush, 0.0});
+  double struck_at = -1.0;
+  for (int k = 0; k < 20; ++k) {
+    a->step(&push);
+    b->step(&push);
+    INFO("step " << k);
+    // The wall's reaction on the last floe, N s a step, against the run without sleeping: to
+    // 1e-9 of itself (about 1e6 N s in the strike's step) and 1 mN s (400 N s, the push alone,
+    // in the others), far below the 400 N s a missing load would take off.
+    const double wall_a = test::contact_force_x(*a, 3, 1.0), wall_b = test::contact_force_x(*b, 3, 1.0);
+    CHECK(std::abs(wall_a - wall_b) <= 1e-3 + 1e-9 * std::abs(wall_b));
+    if (struck_at < 0.0 && std::abs(wall_b) > 1e4) struck_at = k;
+    for (std::size_t i = 0; i < 3; ++i) {
+      CHECK(std::abs(a->state().velocity[i].x - b->state().velocity[i].x) <= 1e-9);
+      CHECK(std::abs(a->state().position[i].x - b->state().position[i].x) <= 1e-9);
+    }
+  }
+  REQUIRE(struck_at > 2.0);  // the sleepers were asleep when struck (sleep_time: 2 steps)
+  CHECK(woken(*a) >= 2);
+}
+
 TEST_CASE("sleep: a free floe under a load too small for the timer does not sleep", "[sleep]") {
   // 1e-8 m/s^2 keeps the floe under sleep_speed (1e-5 m/s) for 1 000 s, far past sleep_time:
   // the balance test (a body without contacts needs no load) keeps it awake.
