@@ -4,8 +4,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <memory>
 #include <unistd.h>
 
+#include "floedem/engine/registry.hpp"
+#include "floedem/io/output.hpp"
 #include "floedem/run/simulation.hpp"
 #include "floedem/scenario/scenario.hpp"
 #include "support.hpp"
@@ -130,4 +134,70 @@ TEST_CASE("stress: a resting column carries its drag to the wall, steady to 0.1 
   CHECK(measured == 1000);
   CHECK(worst <= 1e-3);
   CHECK(overlap < 0.01);
+}
+
+namespace {
+/// The native engine, whose state turns non-finite after `kFiniteSteps` steps while `armed`:
+/// what a solver that blows up hands the run loop. Registered for the whole test program, so
+/// unarmed it is the native engine, for any test that runs every engine.
+class BlowsUp final : public Engine {
+ public:
+  static constexpr int kFiniteSteps = 25;
+  static inline bool armed = false;
+  explicit BlowsUp(const Scene& scene) : inner_(make_engine("native", scene)), state_(inner_->state()) {}
+  void step(const Loads* loads) override {
+    inner_->step(loads);
+    state_ = inner_->state();
+    if (armed && ++steps_ > kFiniteSteps) state_.velocity[0].x = std::numeric_limits<double>::quiet_NaN();
+  }
+  const BodyStates& state() const override { return state_; }
+  std::span<const ContactRecord> contacts() const override { return inner_->contacts(); }
+  EngineInfo info() const override {
+    EngineInfo i = inner_->info();
+    i.name = "test_blows_up";
+    return i;
+  }
+
+ private:
+  std::unique_ptr<Engine> inner_;
+  BodyStates state_;
+  int steps_ = 0;
+};
+}  // namespace
+
+TEST_CASE("stress: a state gone non-finite stops the run, its frames kept in the .partial only", "[stress][bad-input]") {
+  static const bool registered = [] {
+    register_engine({"test_blows_up", "the native engine, its state non-finite after 25 steps when armed (a test's)",
+                     [](const Scene& s) { return std::make_unique<BlowsUp>(s); }});
+    return true;
+  }();
+  REQUIRE(registered);
+  const Scene s = load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/head_on.toml", {"run.output_every=10"});
+  const fs::path dir = test::temp_dir("blows-up");
+  fs::create_directories(dir);
+  RunOptions o;
+  o.engine = "test_blows_up";
+  o.output = (dir / "run.h5").string();
+  struct Armed {
+    Armed() { BlowsUp::armed = true; }
+    ~Armed() { BlowsUp::armed = false; }
+  } armed;
+  try {
+    run_scene(s, o);
+    FAIL("the run went on past a non-finite state");
+  } catch (const SolverFailure& e) {
+    const std::string what = e.what();
+    INFO(what);
+    // One line: the step, and where the output so far is.
+    CHECK(what.find("non-finite body state at step " + std::to_string(BlowsUp::kFiniteSteps + 1)) == 0);
+    CHECK(what.find(o.output + ".partial") != std::string::npos);
+    CHECK(what.find('\n') == std::string::npos);
+  }
+  // No file that looks finished; the frames before the failure are where the message says.
+  CHECK_FALSE(fs::exists(o.output));
+  REQUIRE(fs::exists(o.output + ".partial"));
+  const StoredRun stored = read_stored_run(o.output + ".partial");
+  CHECK(stored.status == "running");  // what a run cut short says of itself (docs/output.md)
+  CHECK(stored.engine == "test_blows_up");
+  fs::remove_all(dir);
 }
