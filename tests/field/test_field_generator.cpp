@@ -260,6 +260,20 @@ TEST_CASE("field: bad parameters name the parameter and the allowed range", "[fi
        }, "self-intersecting"},
       {"keep_out[0]", [](FieldSpec& s) { s.keep_out = {{s.origin, s.origin + Vec2{4e75, 0}, s.origin + Vec2{0, 50}}}; },
        "within 1e7 m"},
+      {"keep_out[0]", [](FieldSpec& s) { s.keep_out = {{s.origin, s.origin + Vec2{50, 0}}}; }, "allowed at least 3"},
+      {"keep_out[0]", [](FieldSpec& s) {
+         s.keep_out = {{s.origin, s.origin + Vec2{50, 0}, s.origin + Vec2{100, 0}}};
+       }, "zero area"},
+      {"origin", [](FieldSpec& s) { s.origin.x = std::nan(""); }, "|x|, |y| <= 1e7 m"},
+      {"origin", [](FieldSpec& s) { s.origin.y = 2e7; }, "|x|, |y| <= 1e7 m"},
+      // The largest floe's cell, pi d_max^2 / (4 C), is 1.57 times the domain.
+      {"d_max", [](FieldSpec& s) { s.d_max = s.width = s.height; }, "smaller than the cell the largest floe needs"},
+      // ... and, with keep-out zones (here all but a 1 m strip), it is they that leave too little room.
+      {"keep_out", [](FieldSpec& s) {
+         s.keep_out = {{s.origin, s.origin + Vec2{s.width, 0}, s.origin + Vec2{s.width, s.height - 1},
+                        s.origin + Vec2{0, s.height - 1}}};
+       }, "smaller keep-out zones"},
+      {"d_min", [](FieldSpec& s) { s.d_min = 1e-5; }, "allowed at most 2e+07"},
   };
   for (const Bad& b : cases) {
     FieldSpec s = spec_for(0.5, 2.0, 500);

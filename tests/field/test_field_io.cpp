@@ -110,6 +110,34 @@ TEST_CASE("scenario [field]: generated around the scenario's bodies, or loaded f
   fs::remove_all(d);
 }
 
+TEST_CASE("scenario [field]: thickness = { mean, std } draws lognormal thicknesses", "[field][input]") {
+  // The scenario's form of the generator's lognormal law (field tests hold the law itself).
+  auto thicknesses = [](const std::string& law) {
+    const Scene scene = test::scene_from(
+        "[run]\nduration = 1.0\ndt = 0.01\n[field]\nwidth = 300\nheight = 200\nconcentration = 0.5\nalpha = 2\n"
+        "d_min = 3\nd_max = 30\nthickness = " + law + "\nseed = 4\n");
+    std::vector<double> h;
+    for (const BodySpec& b : scene.bodies) h.push_back(b.thickness);
+    return h;
+  };
+  const std::vector<double> h = thicknesses("{ mean = 1.2, std = 0.4 }");
+  REQUIRE(h.size() > 100);
+  double mean = 0.0, square = 0.0;
+  for (const double x : h) {
+    CHECK(x > 0.0);
+    mean += x;
+    square += x * x;
+  }
+  const auto n = static_cast<double>(h.size());
+  mean /= n;
+  const double sd = std::sqrt(square / n - mean * mean);
+  INFO(h.size() << " floes: mean " << mean << " m, standard deviation " << sd << " m");
+  // Sampling error: 4 standard errors of the mean (0.4 / sqrt(n)), and a fifth on the spread.
+  CHECK(std::abs(mean - 1.2) < 4.0 * 0.4 / std::sqrt(n));
+  CHECK(std::abs(sd - 0.4) < 0.2 * 0.4);
+  for (const double x : thicknesses("{ mean = 1.2, std = 0.0 }")) CHECK(x == Approx(1.2).epsilon(1e-15));
+}
+
 TEST_CASE("scenario [field]: bad keys are refused with file, field and range", "[field][input]") {
   const std::string run = "[run]\nduration = 1.0\ndt = 0.01\n";
   const std::string ok = "width = 300\nheight = 200\nalpha = 2\nd_min = 3\nd_max = 30\nthickness = 1\n";

@@ -194,6 +194,21 @@ TEST_CASE("wave radiation force: magnitude and direction for two wave directions
   }
 }
 
+TEST_CASE("waves: a period gives the deep-water wavelength, a wavelength the period", "[environment][waves][input]") {
+  // Deep water: L = g T^2 / (2 pi), either way round (scenarios/README.md, [environment.waves]).
+  auto waves = [](const std::string& given) {
+    return test::scene_from("[run]\nduration = 1.0\ndt = 0.1\n[environment]\n[environment.waves]\namplitude = 1.0\n" +
+                            given + floe("a", {0, 0}, 10))
+        .environment.waves;
+  };
+  const WaveSpec by_period = waves("period = 8.0\n"), by_length = waves("wavelength = 99.9\n");
+  CHECK(by_period.wavelength == Approx(9.81 * 64.0 / (2.0 * M_PI)).epsilon(1e-14));
+  CHECK(by_length.period == Approx(std::sqrt(2.0 * M_PI * 99.9 / 9.81)).epsilon(1e-14));
+  const WaveSpec round = waves("wavelength = " + std::to_string(by_period.wavelength) + "\n");
+  CHECK(round.period == Approx(8.0).epsilon(1e-6));  // to_string's 6 decimals
+  CHECK_THROWS_WITH(waves("period = 8.0\nwavelength = 99.9\n"), Catch::Contains("not both"));
+}
+
 TEST_CASE("rotational damping: a spinning floe in still water slows monotonically", "[environment][drag]") {
   const Scene s = test::scene_from("[run]\nduration = 100.0\ndt = 0.1\n[environment]\n" + floe("a", {0, 0}, 10, {}, 0.05));
   auto e = test::native(s);
@@ -232,7 +247,7 @@ TEST_CASE("form drag uses the width measured on the polygon, across the flow", "
 
 TEST_CASE("drag coefficients: kind defaults, then per-kind, then per-body overrides", "[environment][input]") {
   const std::string text = "[run]\nduration = 1.0\ndt = 0.1\n[environment]\n[environment.drag]\nwater_form = 0.7\n"
-                           "[environment.drag.iceberg]\nwater_form = 1.1\n"
+                           "[environment.drag.iceberg]\nwater_form = 1.1\n[environment.drag.floe]\nwater_skin = 1e-3\n"
                            "[[body]]\nname = \"a\"\npolygon = [[0,0],[1,0],[1,1],[0,1]]\nthickness = 1\n"
                            "[[body]]\nname = \"b\"\npolygon = [[2,0],[3,0],[3,1],[2,1]]\nthickness = 1\n[body.drag]\nwater_form = 2.0\n"
                            "[[body]]\nname = \"c\"\nkind = \"iceberg\"\npolygon = [[5,0],[8,0],[8,3],[5,3]]\ndraft = 10\nsail_height = 2\n";
@@ -240,7 +255,10 @@ TEST_CASE("drag coefficients: kind defaults, then per-kind, then per-body overri
   CHECK(s.bodies[0].drag.water_form == 0.7);
   CHECK(s.bodies[1].drag.water_form == 2.0);
   CHECK(s.bodies[2].drag.water_form == 1.1);
-  CHECK(s.bodies[0].drag.water_skin == 5e-4);  // untouched default
+  CHECK(s.bodies[0].drag.water_skin == 1e-3);  // the floes' own
+  CHECK(s.bodies[1].drag.water_skin == 1e-3);  // ... under the body's override of another coefficient
+  CHECK(s.bodies[2].drag.water_skin == 5e-4);  // untouched default: the iceberg's
+  CHECK(s.bodies[0].drag.air_form == 1.3);
   // Iceberg mass rho_i A (draft + sail) by default, added mass 0.5.
   CHECK(s.bodies[2].mass == Approx(900.0 * 9.0 * 12.0));
   CHECK(s.bodies[2].added_mass_coefficient == 0.5);

@@ -11,6 +11,8 @@ namespace {
 
 const std::string kRun = "[run]\nduration = 1.0\ndt = 0.01\n";
 const std::string kBody = "[[body]]\nname = \"a\"\npolygon = [[0,0],[1,0],[1,1],[0,1]]\nthickness = 1.0\n";
+const std::string kIceberg =
+    "[[body]]\nname = \"berg\"\nkind = \"iceberg\"\npolygon = [[0,0],[50,0],[50,50],[0,50]]\ndraft = 40.0\nsail_height = 10.0\n";
 
 std::string error_of(const std::string& text) {
   try {
@@ -67,6 +69,15 @@ TEST_CASE("bad scenarios are refused with file, field, line and range", "[input]
       {"not TOML", "[run\nduration = 1\n", {"test.toml:1", "not valid TOML"}},
       {"bad output choice", kRun + "[output]\ncontacts = \"some\"\n" + kBody, {"'output.contacts'", "\"all\""}},
       {"unknown engine table", kRun + kBody + "[engine.havok]\nx = 1\n", {}},  // refused by the registry (below)
+      {"engine settings not a table", kRun + kBody + "[engine]\nnative = 1\n", {"'engine.native'", "expected a table"}},
+      {"current profile not deepening", kRun + "[environment]\ncurrent_profile = [[0, 0.1, 0], [10, 0.1, 0], [5, 0, 0]]\n" + kBody,
+       {"'environment.current_profile'", "depths must increase", "row 2"}},
+      {"sea surface tilt without latitude", kRun + "[environment]\ncurrent = [0.1, 0.0]\nsea_surface_tilt = true\n" + kBody,
+       {"'environment.sea_surface_tilt'", "needs a latitude"}},
+      {"keel layers short of the draft", kRun + kIceberg + "keel_layers = [[20.0, 1.0], [10.0, 0.8]]\n",
+       {"'body[0].keel_layers'", "add up to 30", "the draft, 40"}},
+      {"keel layer too wide", kRun + kIceberg + "keel_layers = [[20.0, 1.0], [20.0, 11.0]]\n",
+       {"'body[0].keel_layers'", "layer 1", "(0, 10]"}},
   };
   for (const Bad& b : cases) {
     if (b.expect.empty()) continue;
@@ -80,6 +91,16 @@ TEST_CASE("bad scenarios are refused with file, field, line and range", "[input]
       CHECK(m.find(s) != std::string::npos);
     }
   }
+}
+
+TEST_CASE("bad --set overrides are refused naming the override", "[input]") {
+  // Not the file's fault: the message names the override as given, and why.
+  const std::string text = kRun + kBody;
+  CHECK_THROWS_WITH(test::scene_from(text, {"body[x].density=917"}),
+                    Catch::StartsWith("--set body[x].density=917") && Catch::Contains("not a whole number"));
+  CHECK_THROWS_WITH(test::scene_from(text, {"run={ duration = 2.0 }"}),
+                    Catch::StartsWith("--set run={ duration = 2.0 }") && Catch::Contains("only scalars"));
+  CHECK_THROWS_WITH(test::scene_from(text, {"run.duration"}), Catch::Contains("expected KEY=VALUE"));
 }
 
 TEST_CASE("bad engine settings and unknown engines are refused", "[input]") {
