@@ -143,8 +143,9 @@ TEST_CASE("a row of 50 floes pressed against a wall stops creeping into it with 
   // Plain Gauss-Seidel carries the wall's reaction one contact per sweep: a pressed chain of 50
   // floes needs about four sweeps per floe to hold still; with fewer it creeps into the wall
   // while the position projection keeps the overlap bounded. After 100 s, each floe's speed
-  // along the channel, into the wall: 5 to 17 mm/s with 50 plain sweeps, at most 0.034 mm/s with
-  // 200 (28 seeds of this row). The bound, 0.1 mm/s, is a tenth of the allowed overlap a second.
+  // along the channel, into the wall: 5 to 17 mm/s with 50 plain sweeps (8 seeds of this row), at
+  // most 0.034 mm/s with 200 (28 seeds). The bound, 0.1 mm/s, is a tenth of the allowed overlap a
+  // second.
   // The floes' sideways drift between the banks is not bounded: only friction damps it, and
   // how fast it still is after 100 s depends on where the slam into the wall left the row (up
   // to 1 cm/s over the same seeds, at 50 sweeps as at 200).
