@@ -60,6 +60,15 @@ inline bool have_engine(const std::string& name) {
 
 inline std::unique_ptr<Engine> native(const Scene& s) { return make_engine("native", s); }
 
+/// The engine's work count `name` so far (Engine::add_work_counts); 0 where it counts none such.
+inline double work_count(const Engine& e, const std::string& name) {
+  std::vector<WorkCount> work;
+  e.add_work_counts(work);
+  for (const WorkCount& w : work)
+    if (w.name == name) return w.count;
+  return 0.0;
+}
+
 /// x component of the contact force on `body` over the engine's last step (its impulses / dt).
 inline double contact_force_x(const Engine& e, int body, double dt) {
   double fx = 0.0;

@@ -328,12 +328,8 @@ TEST_CASE("redetect: the islands the widened reach cannot touch are not solved a
         if (std::max(c.body_a, c.body_b) >= 3)
           r.far_path.insert(r.far_path.end(), {c.normal_impulse, c.tangent_impulse, static_cast<double>(c.kind)});
     }
-    std::vector<WorkCount> work;
-    e->add_work_counts(work);
-    for (const WorkCount& w : work) {
-      if (w.name == "islands") r.islands = w.count;
-      if (w.name == "redetections") r.redetections = w.count;
-    }
+    r.islands = test::work_count(*e, "islands");
+    r.redetections = test::work_count(*e, "redetections");
     return r;
   };
   const Run with = run(true, true, true), row_alone = run(true, true, false), far_alone = run(true, false, true),
@@ -354,8 +350,8 @@ TEST_CASE("redetect: a point the first pass held is classified as it was, not on
           "[impacts]") {
   // As above, a floe struck across its 5 cm gap within one step onto a fixed wall; a third floe,
   // 6 m wide, rests on the middle of the struck one's top face, pushed down onto it by a load of
-  // F dt / m = 0.006 m/s a step (above the 1e-3 m/s collision threshold). In the first step its contact is new and
-  // it does not approach before the loads: resting. The redetection solves the struck floe's
+  // F dt / m = 0.006 m/s a step (above the 1e-3 m/s collision threshold). In the first step its
+  // contact is new and it does not approach before the loads: resting. The redetection solves the struck floe's
   // island again from the velocities after the loads, where the pressed floe approaches at
   // 0.006 m/s: classified on those, it would be a collision, and with e = 1 it would leave the
   // struck floe's face at 0.006 m/s in the step the struck floe hit the wall.
@@ -378,10 +374,7 @@ TEST_CASE("redetect: a point the first pass held is classified as it was, not on
     r.leaving = e.state().velocity[3].y - e.state().velocity[1].y;
     for (const ContactRecord& c : e.contacts())
       if (c.body_a == 1 && c.body_b == 3) r.pressed.push_back(c);
-    std::vector<WorkCount> work;
-    e.add_work_counts(work);
-    for (const WorkCount& w : work)
-      if (w.name == "redetections") r.redetections = w.count;
+    r.redetections = test::work_count(e, "redetections");
     return r;
   };
   const auto with = first_step(true), without = first_step(false);

@@ -115,12 +115,7 @@ TEST_CASE("sleep: a floe struck across a gap into a sleeping one within a step w
     REQUIRE(same_state(a->state(), b->state()));
     for (const ContactRecord& c : a->contacts()) deepest = std::max(deepest, -c.separation);
   }
-  std::vector<WorkCount> work;
-  a->add_work_counts(work);
-  double redetections = 0.0;
-  for (const WorkCount& w : work)
-    if (w.name == "redetections") redetections = w.count;
-  CHECK(redetections >= 1.0);
+  CHECK(test::work_count(*a, "redetections") >= 1.0);
   CHECK(woken(*a) >= 2);             // the middle floe, then the last
   // The last floe was struck, and momentum kept (equal masses, no drag in this scene).
   const std::vector<Vec2>& v = a->state().velocity;
