@@ -64,7 +64,6 @@ namespace {
 struct RowResult {
   double worst_gain = 0.0;
   double largest_energy = 0.0;
-  double fastest_end = 0.0;
   double fastest_along_end = 0.0;  ///< m/s, the largest |v_x| at the end: along the channel
   double max_overlap = 0.0;      ///< m, over the whole run
   double max_overlap_end = 0.0;  ///< m, over the last 100 steps
@@ -72,12 +71,12 @@ struct RowResult {
 };
 
 /// 50 floes in a channel (fixed banks 0.6 m clear of them on each side), each pushed towards a
-/// fixed wall at the end by its own constant force, with random offsets, tilts and velocities.
-/// `native`: the [engine.native] table's lines.
-RowResult press_row(double mu, const std::string& native) {
+/// fixed wall at the end by its own constant force, with random offsets, tilts and velocities
+/// drawn from `seed`. `native`: the [engine.native] table's lines.
+RowResult press_row(double mu, const std::string& native, unsigned seed = 7) {
   const double dt = 0.01;
   const int n = 50;
-  std::mt19937_64 rng(7);
+  std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::string text = test::header_toml(100.0, dt, 0.3, mu, "[engine.native]\n" + native);
   std::vector<Vec2> force(n);
@@ -120,7 +119,6 @@ RowResult press_row(double mu, const std::string& native) {
     }
   }
   for (int i = 0; i < n; ++i) {
-    r.fastest_end = std::max(r.fastest_end, length(e->state().velocity[i]));
     r.fastest_along_end = std::max(r.fastest_along_end, std::abs(e->state().velocity[i].x));
   }
   r.mean_sweeps = std::stod(e->info().settings.at("mean_sweeps_per_step"));
@@ -146,9 +144,7 @@ TEST_CASE("a row of 50 floes pressed against a wall stops creeping into it with 
   // along the channel, into the wall: 5 to 17 mm/s with 50 plain sweeps (8 seeds of this row), at
   // most 0.034 mm/s with 200 (28 seeds). The bound, 0.1 mm/s, is a tenth of the allowed overlap a
   // second.
-  // The floes' sideways drift between the banks is not bounded: only friction damps it, and
-  // how fast it still is after 100 s depends on where the slam into the wall left the row (up
-  // to 1 cm/s over the same seeds, at 50 sweeps as at 200).
+  // The floes' sideways motion between the banks is not bounded: see the next test.
   const RowResult r = press_row(0.3, "velocity_iterations = 200\nextra_iterations = 0\naccelerate = false\n");
   CHECK(r.worst_gain <= 1e-9 * r.largest_energy);
   CHECK(r.fastest_along_end < 1e-4);
@@ -162,15 +158,29 @@ TEST_CASE("a row of 50 floes pressed against a wall stops creeping into it with 
 TEST_CASE("the default sweeps hold a pressed row of 50 floes, plain sweeps as many do not", "[resting]") {
   // The default: 50 sweeps, each followed by a conjugate-gradient step, and up to 450 more while
   // a point would close by more than the allowed overlap (1 mm) within the step.
+  //
+  // Held means no creep into the wall: over the last second the overlap stays at what the
+  // position projection leaves (the allowed 1 mm; the projection stops at 1.5 times it), where
+  // plain sweeps as many pile 8.7 to 10.6 mm (28 seeds of this row; defaults 1.0 to 1.1 mm).
+  // That the row comes to rest is not asked. Where two neighbours' faces are not flush they
+  // touch at one corner, and the flush runs of floes between such corners can turn as rigid
+  // bodies about them, each corner a hinge that does not slip: the pressed row buckles between
+  // the banks as a linkage that friction cannot damp (there is no water here). Seed 4 does so
+  // with the defaults (runs of 17 and 8 floes turning at 1e-4 and 2e-4 rad/s after 100 s, up to
+  // 1.8 cm/s at their far ends) and, more slowly, with 500 sweeps; seed 7's row falls asleep.
+  // Over 28 seeds the defaults leave 12 rows moving faster than 1e-6 m/s, none piling overlap.
   const RowResult fast = press_row(0.3, "");
-  CHECK(fast.worst_gain <= 1e-9 * fast.largest_energy);
-  CHECK(fast.fastest_end < 1e-6);
-  // 1 % of the 1 m thickness (the stress suite's bound), with the pack slamming in at ~2 m/s.
-  CHECK(fast.max_overlap < 0.01);
-  CHECK(fast.max_overlap_end < 0.005);
+  const RowResult buckled = press_row(0.3, "", 4);
+  for (const RowResult* r : {&fast, &buckled}) {
+    CHECK(r->worst_gain <= 1e-9 * r->largest_energy);
+    // 1 % of the 1 m thickness (the stress suite's bound), with the pack slamming in at ~2 m/s.
+    CHECK(r->max_overlap < 0.01);
+    CHECK(r->max_overlap_end < 1.5e-3);
+  }
   // The same 50 sweeps, plain and never more: the chain creeps into the wall.
   const RowResult plain = press_row(0.3, "extra_iterations = 0\naccelerate = false\n");
   CHECK(plain.max_overlap > 2.0 * fast.max_overlap);
+  CHECK(plain.max_overlap_end > 5e-3);
   // And the acceleration earns its pass: the sweeps made with room for 1000 a step, stopping
   // where no point would close by more than 0.01 mm within the step (1 mm/s).
   const std::string kToClose = "velocity_iterations = 1\nextra_iterations = 999\nallowed_penetration = 1e-5\n";
