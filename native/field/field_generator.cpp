@@ -535,12 +535,10 @@ void check_field_spec(const FieldSpec& s) {
                              " m^2, is smaller than the cell the largest floe needs at this concentration, "
                              "pi d_max^2 / (4 C) = " + num(largest_cell) + " m^2; allowed a larger domain, "
                              "smaller keep-out zones or a smaller d_max");
+  // The ice, C times the free area, is now at least one floe of d_max, so at least one of d_min
+  // (stratified_sizes' precondition): no check of its own.
   const TruncatedPowerLaw law{s.alpha, s.d_min, s.d_max};
-  const double ice = s.concentration * d.free_area;
-  if (ice < area_of_diameter(s.d_min))
-    throw FieldSpecError("concentration", "concentration " + num(s.concentration) + " gives " + num(ice) +
-                                              " m^2 of ice, less than one floe of d_min; allowed a larger value");
-  const double floes = ice / law.mean_area();
+  const double floes = s.concentration * d.free_area / law.mean_area();
   if (floes > FieldSpec::max_floes)
     throw FieldSpecError("d_min", "d_min = " + num(s.d_min) + " m gives about " + num(floes) +
                                       " floes; allowed at most " + num(FieldSpec::max_floes) +
