@@ -44,6 +44,13 @@ BASE_SEED = 2016
 # (--quick) the interval is wide (t = 12.7 for one degree of freedom): the quick check catches
 # gross disagreement only, which is its purpose in CI.
 TOL_ENGINE_REL = 0.10
+# Each engine's ensemble runs at a step where its own answer no longer moves with the step: the
+# scenario's 0.1 s, except Bullet's 0.05 s. Bullet finds a contact only once the hulls overlap,
+# and its mean ice force falls by 6 to 12 % from 0.1 to 0.05 s and then holds (0.025 s gives the
+# same), where native's holds from 0.2 s down (docs/engines.md, "Agreement"). Compared at 0.1 s,
+# the check would measure Bullet's step error, not the physics it shares with native.
+ENGINE_DT = {"bullet": 0.05}
+DT = 0.1             # s, the scenario's step
 # The domain check (the full case only: --quick's field is narrow on purpose): a 1.6 times wider
 # field, mean ice force within 5 % or 3 standard errors.
 TOL_DOMAIN_REL = 0.05
@@ -85,13 +92,16 @@ def plan(ctx):
     c = config(ctx.quick)
     sc = os.path.join(ctx.scenarios, SCENARIO)
     n_floes = 5200 if not ctx.quick else 1200
-    steps = c["duration"] / 0.1
+    steps = c["duration"] / DT
     relative = {"native": 1.0, "box2d": 1.2, "bullet": 2.5, "ode": 2.5}
     runs = []
     for e in ctx.engines:
+        dt = ENGINE_DT.get(e, DT)
+        # The /tow rows stay 1 s means whatever the step (the scenario's tow_every is 10 steps).
+        step = [] if dt == DT else [f"run.dt={dt!r}", f"output.tow_every={round(1.0 / dt)}"]
         for k in range(SEEDS_ENGINES[ctx.quick]):
-            runs.append(Run(seeded(f"towing_{e}", k), sc, e, list(c["sets"]) + seed_sets(k),
-                            cost=steps * n_floes * 2e-6 * relative.get(e, 3.0), meta=dict(part="engines")))
+            runs.append(Run(seeded(f"towing_{e}", k), sc, e, list(c["sets"]) + step + seed_sets(k),
+                            cost=steps * DT / dt * n_floes * 2e-6 * relative.get(e, 3.0), meta=dict(part="engines")))
     native_cost = steps * n_floes * 2e-6
     runs.append(Run("towing_wide", sc, "native", c["wide"] + LIGHT, cost=1.6 * native_cost, meta=dict(part="wide")))
     seeds = range(SEEDS_SWEEPS[ctx.quick])
@@ -263,7 +273,9 @@ def write(ctx):
     md += [f"`scenarios/{SCENARIO}`{' (smaller for --quick: ' + ', '.join(c['sets']) + ')' if c['sets'] else ''}: "
            f"the iceberg ({base.width:.0f} m across the tow) towed at {SPEED} m/s after a {RAMP:.0f} s ramp through "
            f"{base.floes} floes of {base.thickness:.2f} m at concentration {base.concentration:.3f}; e = 0.1, mu = 0.3, "
-           f"dt = 0.1 s. Statistics over the stationary part, after {c['s_stat']:.0f} m of travel "
+           f"dt = {DT} s" + "".join(f" ({e}: {dt} s, where its force has stopped moving with the step: "
+                                     "docs/engines.md)" for e, dt in ENGINE_DT.items() if e in ctx.engines) +
+           f". Statistics over the stationary part, after {c['s_stat']:.0f} m of travel "
            f"(t >= {base.t_stat:.0f} s, {base.stat_seconds:.0f} s), of the 1 s means of the force along the tow. "
            f"The ice part is minus the contact force on the iceberg: the towing force less the open-water drag "
            f"({kn(drag)} kN at {SPEED} m/s, `{os.path.relpath(ctx.run('towing_open_water').out, rel)}`).", "",
