@@ -332,6 +332,8 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     dirty_.assign(moving.begin(), moving.end());
     have_dirty_ = true;
   }
+  loads_.listed = sparse;  // the loads of the bodies at rest zeroed, the moving ones' set
+  if (sparse) loads_.loaded.assign(moving.begin(), moving.end());
   note_ahead();
   return &loads_;
 }

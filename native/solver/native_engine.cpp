@@ -109,8 +109,19 @@ class NativeEngine final : public Engine {
   bool wake_touched();
   void fall_asleep(bool solved);
   void sleep_group(std::span<const std::int32_t> bodies);
+  void settle();          // the sleepers that have been asleep long enough join settled_
+  void refresh_active();  // active_bodies_ and active_parts_ again, after a body settled or woke
+  // f(i) for each body but the settled sleepers, ascending, in blocks of `grain` on the pool's
+  // threads (kSerial: one block, on the calling thread).
+  template <class F>
+  void for_active_bodies(std::size_t grain, F&& f);
+  static constexpr std::size_t kSerial = 0;
   // The balance tolerance, m/s^2: a thousandth of the speed the timer sees over sleep_time.
   double balance_tolerance() const { return 1e-3 * settings_.sleep_speed / settings_.sleep_time; }
+  // Whether sleeping body b's load at its first step asleep is not zero, or not yet seen (NaN).
+  bool loaded_sleeper(std::size_t b) const {
+    return !(sleep_force_[b].x == 0.0 && sleep_force_[b].y == 0.0 && sleep_torque_[b] == 0.0);
+  }
   // Whether a load (f, t) on body b moves its fastest point beyond the balance tolerance.
   bool out_of_balance(std::size_t b, Vec2 f, double t) const {
     return length(f) * own_inv_mass_[b] > balance_tolerance() ||
@@ -248,6 +259,19 @@ class NativeEngine final : public Engine {
   std::int64_t asleep_count_ = 0;          // bodies asleep now
   std::int64_t asleep_steps_ = 0;          // sum over steps of the bodies asleep (info: their mean)
   std::int64_t wakes_ = 0;                 // groups woken over the run
+  std::int64_t loaded_sleepers_ = 0;       // sleeping bodies whose load at sleep is not yet seen, or not zero
+  // Settled sleepers. A body asleep since the end of step s has, from step s + 2 on, zero
+  // velocity and reach and the same placement, part boxes and fat boxes every step, until it
+  // wakes (its position could still change in step s + 1: a velocity of zero moves -0 to +0).
+  // From step s + 3 the passes over bodies and parts of the broad phase, the loads and the
+  // integration leave it out, going over the lists of the rest instead (ascending): the same
+  // values to the bit, without a visit to the towing case's 4 000 floes at rest.
+  std::vector<std::int64_t> asleep_since_;   // per body: the step at whose end it last fell asleep
+  std::vector<std::uint8_t> settled_;        // per body
+  std::vector<std::int32_t> settling_;       // bodies that fell asleep and have not settled yet
+  std::vector<std::int32_t> active_bodies_, active_parts_;  // the bodies not settled, and their parts
+  std::int64_t settled_count_ = 0;
+  bool active_stale_ = false;              // a body settled or woke since the lists were made
   const Loads* step_loads_ = nullptr;      // this step's loads (nullptr: none) ...
   bool loads_applied_ = false;             // ... and whether apply_loads has run: a group woken after it gets its loads then
   bool wake_reach_grew_ = false;           // a body woken in the narrow phase has another reach than asleep
@@ -305,6 +329,11 @@ NativeEngine::NativeEngine(const Scene& scene)
   group_first_.reserve(n);
   free_groups_.reserve(n);
   in_island_.assign(n, 0);
+  asleep_since_.assign(n, 0);
+  settled_.assign(n, 0);
+  settling_.reserve(n);
+  active_bodies_.reserve(n);
+  active_parts_.reserve(parts_.size());
   part_boxes_.resize(parts_.size());
   linear_reach_.resize(n);
   angular_reach_.resize(n);
@@ -443,6 +472,13 @@ void NativeEngine::restore_state(StateReader& in) {
   group_first_.clear();
   free_groups_.clear();
   asleep_count_ = 0;
+  loaded_sleepers_ = 0;
+  // A restored run places every part afresh (PartSet keeps no placement across a checkpoint):
+  // its sleepers settle as if they had just fallen asleep.
+  settling_.clear();
+  settled_count_ = 0;
+  std::fill(settled_.begin(), settled_.end(), 0);
+  active_stale_ = true;
   for (std::size_t b = 0; b < n; ++b) {
     const std::int32_t g = sleep_group_[b];
     next_in_group_[b] = -1;
@@ -454,6 +490,9 @@ void NativeEngine::restore_state(StateReader& in) {
     next_in_group_[b] = group_first_[static_cast<std::size_t>(g)];
     group_first_[static_cast<std::size_t>(g)] = static_cast<std::int32_t>(b);
     ++asleep_count_;
+    loaded_sleepers_ += loaded_sleeper(b);
+    asleep_since_[b] = steps_;
+    settling_.push_back(static_cast<std::int32_t>(b));
   }
   for (std::size_t g = group_first_.size(); g-- > 0;)
     if (group_first_[g] < 0) free_groups_.push_back(static_cast<std::int32_t>(g));
@@ -705,8 +744,15 @@ bool NativeEngine::touches_sleeper() const {
 }
 
 void NativeEngine::find_pairs(const Loads* loads) {
+  if (!settling_.empty()) settle();
   set_reach(loads);
-  any_kept_ = parts_.place(bodies_.position, bodies_.rotation);
+  refresh_active();
+  if (settled_count_ > 0) {
+    parts_.place(bodies_.position, bodies_.rotation, active_parts_);
+    any_kept_ = true;  // the settled sleepers' parts, held where they were placed
+  } else {
+    any_kept_ = parts_.place(bodies_.position, bodies_.rotation);
+  }
   pair_up();
 }
 
@@ -714,9 +760,7 @@ void NativeEngine::set_reach(const Loads* loads) {
   // Reach: how far any point of a body can travel this step (dt times its speed after the
   // loads, plus spin times the part's radius), so that contacts are found before the bodies
   // would overlap (speculative contact) and their bounds need no rebuild within the step.
-  thread_pool().for_blocks(bodies_.position.size(), 8192, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) set_reach(i, loads);
-  });
+  for_active_bodies(8192, [&](std::size_t i) { set_reach(i, loads); });
 }
 
 bool NativeEngine::set_reach(std::size_t i, const Loads* loads) {
@@ -741,16 +785,20 @@ void NativeEngine::forget_narrow() {
 }
 
 void NativeEngine::pair_up() {
-  thread_pool().for_blocks(parts_.size(), 8192, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      part_reach_[k] = reach_of_part(static_cast<std::int32_t>(k));
-      part_boxes_[k] = reach_box(static_cast<std::int32_t>(k), part_reach_[k]);
+  refresh_active();
+  const bool skip = settled_count_ > 0;  // a settled sleeper's parts keep what they have
+  thread_pool().for_blocks(skip ? active_parts_.size() : parts_.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t j = begin; j < end; ++j) {
+      const std::int32_t k = skip ? active_parts_[j] : static_cast<std::int32_t>(j);
+      part_reach_[k] = reach_of_part(k);
+      part_boxes_[k] = reach_box(k, part_reach_[k]);
       // A part that leaves its fat box gets room for about four steps at its present reach and
       // a tenth of its size besides (so that a floe at rest, or creeping, keeps its box long).
-      part_margin_[k] = 4.0 * part_reach_[k] + 0.1 * parts_.radius(static_cast<std::int32_t>(k));
+      part_margin_[k] = 4.0 * part_reach_[k] + 0.1 * parts_.radius(k);
     }
   });
-  pair_cache_.find_pairs(part_boxes_, part_margin_, parts_.body(), parts_.immovable(), pairs_);
+  pair_cache_.find_pairs(part_boxes_, part_margin_, parts_.body(), parts_.immovable(), pairs_,
+                         skip ? std::span<const std::int32_t>(active_parts_) : std::span<const std::int32_t>());
 }
 
 double NativeEngine::reach_of_part(std::int32_t k) const {
@@ -1176,27 +1224,24 @@ double NativeEngine::contact_kinetic_energy() const {
 }
 
 void NativeEngine::apply_loads(const Loads& loads) {
-  const std::size_t nb = bodies_.position.size();
+  // A settled sleeper is left out: its velocity is zero, turned or pushed through its zero
+  // inverse mass it stays zero.
   if (!loads.velocity_turn.empty())
-    for (std::size_t i = 0; i < nb; ++i) bodies_.velocity[i] = loads.velocity_turn[i].apply(bodies_.velocity[i]);
+    for_active_bodies(kSerial, [&](std::size_t i) { bodies_.velocity[i] = loads.velocity_turn[i].apply(bodies_.velocity[i]); });
   if (!loads.any) return;
-  thread_pool().for_blocks(nb, 8192, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      bodies_.velocity[i] += (dt_ * bodies_.inv_mass[i]) * loads.force[i];
-      bodies_.angular_velocity[i] += dt_ * bodies_.inv_inertia[i] * loads.torque[i];
-    }
+  for_active_bodies(8192, [&](std::size_t i) {
+    bodies_.velocity[i] += (dt_ * bodies_.inv_mass[i]) * loads.force[i];
+    bodies_.angular_velocity[i] += dt_ * bodies_.inv_inertia[i] * loads.torque[i];
   });
 }
 
 void NativeEngine::integrate() {
-  thread_pool().for_blocks(bodies_.position.size(), 4096, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      if (!moves_[i]) continue;
-      bodies_.position[i] += dt_ * bodies_.velocity[i];
-      if (bodies_.angular_velocity[i] != 0.0) {
-        bodies_.angle[i] += dt_ * bodies_.angular_velocity[i];
-        bodies_.rotation[i] = Rot::from_angle(bodies_.angle[i]);
-      }
+  for_active_bodies(4096, [&](std::size_t i) {
+    if (!moves_[i]) return;
+    bodies_.position[i] += dt_ * bodies_.velocity[i];
+    if (bodies_.angular_velocity[i] != 0.0) {
+      bodies_.angle[i] += dt_ * bodies_.angular_velocity[i];
+      bodies_.rotation[i] = Rot::from_angle(bodies_.angle[i]);
     }
   });
 }
@@ -1245,8 +1290,57 @@ void NativeEngine::sleep_group(std::span<const std::int32_t> bodies) {
     bodies_.inv_mass[b] = bodies_.inv_inertia[b] = 0.0;
     sleep_force_[b] = Vec2{nan, nan};  // taken at its first step asleep, at rest
     sleep_torque_[b] = nan;
+    asleep_since_[b] = steps_;
+    settling_.push_back(b);
   }
   asleep_count_ += static_cast<std::int64_t>(bodies.size());
+  loaded_sleepers_ += static_cast<std::int64_t>(bodies.size());
+}
+
+void NativeEngine::settle() {
+  // A body asleep since the end of step s settles at the start of step s + 3 (the lists'
+  // comment says why): its parts are held as placed, and the lists are made again.
+  std::size_t left = 0;
+  for (const std::int32_t b : settling_) {
+    if (!asleep(b) || settled_[b]) continue;  // woken since (or listed twice, asleep again)
+    if (steps_ < asleep_since_[b] + 3) {
+      settling_[left++] = b;
+      continue;
+    }
+    settled_[b] = 1;
+    ++settled_count_;
+    for (std::int32_t k = parts_.first_part(b); k < parts_.first_part(b + 1); ++k) parts_.hold(k);
+    active_stale_ = true;
+  }
+  settling_.resize(left);
+}
+
+void NativeEngine::refresh_active() {
+  if (!active_stale_) return;
+  active_stale_ = false;
+  active_bodies_.clear();
+  active_parts_.clear();
+  for (std::size_t b = 0; b < settled_.size(); ++b) {
+    if (settled_[b]) continue;
+    const auto body = static_cast<std::int32_t>(b);
+    active_bodies_.push_back(body);
+    for (std::int32_t k = parts_.first_part(body); k < parts_.first_part(body + 1); ++k) active_parts_.push_back(k);
+  }
+}
+
+template <class F>
+void NativeEngine::for_active_bodies(std::size_t grain, F&& f) {
+  refresh_active();
+  const bool skip = settled_count_ > 0;
+  const std::size_t count = skip ? active_bodies_.size() : bodies_.position.size();
+  auto body = [&](std::size_t j) { return skip ? static_cast<std::size_t>(active_bodies_[j]) : j; };
+  if (grain == kSerial) {
+    for (std::size_t j = 0; j < count; ++j) f(body(j));
+    return;
+  }
+  thread_pool().for_blocks(count, grain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t j = begin; j < end; ++j) f(body(j));
+  });
 }
 
 void NativeEngine::wake_group(std::int32_t group) {
@@ -1254,6 +1348,12 @@ void NativeEngine::wake_group(std::int32_t group) {
   for (std::int32_t b = group_first_[static_cast<std::size_t>(group)]; b >= 0; b = next_in_group_[b], ++count) {
     sleep_group_[b] = -1;
     rest_time_[b] = 0.0;
+    loaded_sleepers_ -= loaded_sleeper(b);
+    if (settled_[b]) {
+      settled_[b] = 0;
+      --settled_count_;
+      active_stale_ = true;
+    }
     bodies_.inv_mass[b] = own_inv_mass_[b];
     bodies_.inv_inertia[b] = own_inv_inertia_[b];
     // Woken in the narrow phase: its loads may give it a reach it did not have asleep, and
@@ -1277,21 +1377,30 @@ bool NativeEngine::wake_on_loads(const Loads* loads) {
   // group. Steady wind and current on a body that does not move give the same load to the bit;
   // a changing wind, a wave or a load switched on does not.
   bool woke = false;
-  for (std::size_t b = 0; b < sleep_group_.size(); ++b) {
+  auto check = [&](std::size_t b) {
     const std::int32_t g = sleep_group_[b];
-    if (g < 0) continue;
+    if (g < 0) return;
     const Vec2 f = loads ? loads->force[b] : Vec2{};
     const double t = loads ? loads->torque[b] : 0.0;
     if (std::isnan(sleep_torque_[b])) {
       sleep_force_[b] = f;
       sleep_torque_[b] = t;
-      continue;
+      loaded_sleepers_ -= !loaded_sleeper(b);
+      return;
     }
     if (out_of_balance(b, f - sleep_force_[b], t - sleep_torque_[b])) {
       wake_group(g);
       woke = true;
     }
+  };
+  // Where every sleeper's load at sleep was zero (the towing case), only a sleeper with a load
+  // now can wake: with no loads, none; with the loaded bodies listed (Loads::listed), a listed one.
+  if (loaded_sleepers_ == 0 && !loads) return false;
+  if (loaded_sleepers_ == 0 && loads->listed) {
+    for (const std::int32_t b : loads->loaded) check(static_cast<std::size_t>(b));
+    return woke;
   }
+  for (std::size_t b = 0; b < sleep_group_.size(); ++b) check(b);
   return woke;
 }
 
@@ -1325,17 +1434,16 @@ void NativeEngine::fall_asleep(bool solved) {
   // without contacts. A body out of balance by more than sleep_speed / sleep_time leaves the
   // speed within sleep_time, so the tolerance on loads, a thousandth of that, is what the timer
   // cannot see for itself: about 1.7e-10 m/s^2 at the defaults.
-  const std::size_t n = bodies_.position.size();
   const double rest = settings_.sleep_time * (1.0 - 1e-9);  // a sum of steps, to rounding
   bool ready = false;  // any awake body at rest for sleep_time (else nothing more to look at)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (own_inv_mass_[i] == 0.0 || sleep_group_[i] >= 0) continue;
+  for_active_bodies(kSerial, [&](std::size_t i) {
+    if (own_inv_mass_[i] == 0.0 || sleep_group_[i] >= 0) return;
     // |v| + |w| r <= sleep_speed, without the square root: |v|^2 <= (sleep_speed - |w| r)^2.
     const double left = settings_.sleep_speed - std::abs(bodies_.angular_velocity[i]) * body_radius_[i];
     const Vec2 v = bodies_.velocity[i];
     rest_time_[i] = left >= 0.0 && v.x * v.x + v.y * v.y <= left * left ? rest_time_[i] + dt_ : 0.0;
     ready = ready || rest_time_[i] >= rest;
-  }
+  });
   if (!ready) return;
   if (has_prescribed_)
     for (const Manifold& m : manifolds_) {
@@ -1369,12 +1477,12 @@ void NativeEngine::fall_asleep(bool solved) {
     }
     sleep_group(bodies);
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    if (own_inv_mass_[i] == 0.0 || sleep_group_[i] >= 0 || in_island_[i] || rest_time_[i] < rest) continue;
+  for_active_bodies(kSerial, [&](std::size_t i) {
+    if (own_inv_mass_[i] == 0.0 || sleep_group_[i] >= 0 || in_island_[i] || rest_time_[i] < rest) return;
     const auto b = static_cast<std::int32_t>(i);
-    if (out_of_balance(i, force(b), step_loads_ ? step_loads_->torque[i] : 0.0)) continue;
+    if (out_of_balance(i, force(b), step_loads_ ? step_loads_->torque[i] : 0.0)) return;
     sleep_group({&b, 1});
-  }
+  });
   if (solved)
     for (const std::int32_t b : islands_.all_bodies()) in_island_[b] = 0;  // for the next step
 }

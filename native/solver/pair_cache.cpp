@@ -24,7 +24,7 @@ std::size_t stale_limit(std::size_t n) {
 
 void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> margin,
                            std::span<const std::int32_t> body, std::span<const std::uint8_t> fixed,
-                           std::vector<PartPair>& out) {
+                           std::vector<PartPair>& out, std::span<const std::int32_t> active) {
   const std::size_t n = boxes.size();
   bool full = fat_.size() != n;
   if (full) {
@@ -34,10 +34,14 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
     stale_list_.clear();
   }
   // Per part (blocks on the pool's threads): a new fat box where it left its own; then, in
-  // part order, the list of those that did.
+  // part order, the list of those that did. A part left out of `active` has not left its box.
+  const bool all = full || active.empty();
+  const std::size_t listed = all ? n : active.size();
+  auto part = [&](std::size_t j) { return all ? j : static_cast<std::size_t>(active[j]); };
   left_.resize(n);
-  thread_pool().for_blocks(n, 8192, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
+  thread_pool().for_blocks(listed, 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t j = begin; j < end; ++j) {
+      const std::size_t k = part(j);
       left_[k] = full || !inside(boxes[k], fat_[k]);
       if (!left_[k]) continue;
       const Vec2 m{margin[k], margin[k]};
@@ -45,8 +49,8 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
     }
   });
   moved_list_.clear();
-  for (std::size_t k = 0; k < n; ++k)
-    if (left_[k]) moved_list_.push_back(static_cast<std::int32_t>(k));
+  for (std::size_t j = 0; j < listed; ++j)
+    if (left_[part(j)]) moved_list_.push_back(static_cast<std::int32_t>(part(j)));
   refreshed_ += static_cast<std::int64_t>(moved_list_.size());
   if (!full) {
     for (const std::int32_t k : moved_list_)

@@ -23,8 +23,12 @@ class PairCache {
  public:
   /// boxes[k]: part k's bounds this step (already grown by its reach); margin[k]: room given
   /// to a part that has left its fat box (m, >= 0); body and fixed as for BroadPhase.
+  /// `active`, where not empty: the parts (ascending) whose boxes may have changed since the
+  /// last call; every other part's box is the one it had then, inside its fat box, and is not
+  /// looked at (the native engine's settled sleepers). The same pairs as without it.
   void find_pairs(std::span<const Aabb> boxes, std::span<const double> margin, std::span<const std::int32_t> body,
-                  std::span<const std::uint8_t> fixed, std::vector<PartPair>& out);
+                  std::span<const std::uint8_t> fixed, std::vector<PartPair>& out,
+                  std::span<const std::int32_t> active = {});
 
   /// Parts whose fat box overlaps `box` (its step box, after find_pairs, lies in its fat box):
   /// the grid for parts unchanged since the last rebuild, the changed ones directly.

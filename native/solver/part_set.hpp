@@ -21,6 +21,12 @@ class PartSet {
   /// whose body's pose is, to the bit, the one of the last call keeps what it has (the same pose
   /// gives the same vertices): kept() says which did. Returns whether any part kept its own.
   bool place(std::span<const Vec2> position, std::span<const Rot> rotation);
+  /// The same for the listed parts alone (ascending): the others are left as they are, kept()
+  /// included. Returns whether any listed part kept its own.
+  bool place(std::span<const Vec2> position, std::span<const Rot> rotation, std::span<const std::int32_t> parts);
+  /// Marks a part kept, for a caller that will leave it out of place() while its body stays
+  /// where it was last placed (the native engine's settled sleepers).
+  void hold(std::int32_t part) { kept_[static_cast<std::size_t>(part)] = 1; }
   /// Per part: 1 where the last place() kept the part's placement (its body did not move).
   std::span<const std::uint8_t> kept() const { return kept_; }
 
@@ -65,6 +71,7 @@ class PartSet {
   std::vector<Vec2> placed_position_;  // per part: the pose it was last placed at (NaN: never)
   std::vector<Rot> placed_rotation_;
   std::vector<std::uint8_t> kept_;
+  bool place_part(std::size_t k, std::span<const Vec2> position, std::span<const Rot> rotation);
 };
 
 }  // namespace floedem

@@ -204,7 +204,8 @@ def sleep_table(sleeping):
     md = ["Sleeping islands (docs/model.md, section 3; `engine.native.sleep`): native's defaults against every "
           "body stepped every step, on the jam (a pack at rest after its first minutes) and the towing case (the "
           "floes far from the iceberg at rest). The mean is what a run's length goes by: a step of a pack that has "
-          "fallen asleep costs its forcing, broad phase and held contacts only.", "",
+          "fallen asleep costs its forcing and its held contacts only (from its third step asleep a body is left out "
+          "of the broad phase, the loads and the integration).", "",
           "| scene | sleep | ms per step (median) | mean | p10-p90 | max penetration (mm) | mean overlap (mm) | "
           "mean: off / on |", "|---|---|---|---|---|---|---|---|"]
     for scene in ("jam", "towing"):

@@ -247,6 +247,17 @@ TEST_CASE("forcing: in still water with Coriolis the moving bodies alone give ev
       for (std::size_t i = 0; i < 6; ++i) loaded = loaded || a->force[i].x != 0.0 || a->torque[i] != 0.0;
       CHECK(loaded);  // the case is not empty: drag acts on the moving floes
     }
+    // Working on the moving bodies alone, it names them (Loads::listed): every body it does not
+    // name has no force and no torque, so an engine may look at the named ones alone.
+    CHECK(a->listed == (k > 0));
+    if (a->listed) {
+      CHECK(std::is_sorted(a->loaded.begin(), a->loaded.end()));
+      std::vector<std::uint8_t> named(s.bodies.size(), 0);
+      for (const std::int32_t i : a->loaded) named[static_cast<std::size_t>(i)] = 1;
+      for (std::size_t i = 0; i < s.bodies.size(); ++i)
+        if (!named[i]) CHECK((a->force[i].x == 0.0 && a->force[i].y == 0.0 && a->torque[i] == 0.0));
+      if (any_moves) CHECK(!a->loaded.empty());
+    }
   }
 }
 

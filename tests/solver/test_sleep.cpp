@@ -194,6 +194,29 @@ TEST_CASE("sleep: two floes in contact drifting under a small common load do not
   CHECK(asleep(*f) > 0.5);
 }
 
+TEST_CASE("sleep: a load on one of the bodies the loads list wakes its sleeping floe", "[sleep]") {
+  // Two floes at rest and apart fall asleep without a load. Then a load comes for the second
+  // alone, in loads that list the bodies they load (Loads::listed, as a forcing in still water
+  // hands them): the engine, which looks at the listed bodies alone once every sleeper's load
+  // at sleep was zero, must wake the second and leave the first asleep.
+  const Scene s = test::scene_from(test::header_toml(20.0, 0.01, 0.3, 0.3, sleep_settings(true, 1.0)) +
+                                   test::body_toml({"first", test::box({0, 0}, 10, 10)}) +
+                                   test::body_toml({"second", test::box({40, 0}, 10, 10)}));
+  auto e = test::native(s);
+  for (int k = 0; k < 300; ++k) e->step(nullptr);  // asleep after 1 s
+  REQUIRE(asleep(*e) > 1.0);
+  Loads listed = loads_on(2, 1, {test::kWallPush, 0.0});
+  listed.listed = true;
+  listed.loaded = {1};
+  const Vec2 first_at = e->state().position[0];
+  e->step(&listed);
+  CHECK(woken(*e) == 1);
+  const double mass = 900.0 * 100.0;
+  CHECK(e->state().velocity[1].x == Approx(test::kWallPush * 0.01 / mass).epsilon(1e-12));
+  CHECK(e->state().velocity[0].x == 0.0);
+  CHECK(e->state().position[0].x == first_at.x);
+}
+
 TEST_CASE("sleep: a checkpoint with sleeping bodies continues to the bit", "[sleep]") {
   const Scene s = test::scene_from(pushed_floe(true) + test::body_toml({"drifter", test::box({-15, 5}, 8, 8), {0.3, 0.0}}));
   const Loads push = loads_on(3, 0, {test::kWallPush, 0.0});

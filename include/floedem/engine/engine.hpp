@@ -57,6 +57,11 @@ struct Loads {
   std::vector<Vec2> force;
   std::vector<double> torque;
   bool any = false;  ///< false: every force entry is zero and the engine may skip them
+  /// True where only the bodies of `loaded` (ascending) may have a force or torque that is not
+  /// zero, and an engine may look at those alone: a scene in still water and air, whose forcing
+  /// works on the moving bodies alone.
+  bool listed = false;
+  std::vector<std::int32_t> loaded;
   std::vector<PrescribedMotion> prescribed;
   /// Empty, or per body a turn of the centroid velocity at the start of the step, before the
   /// forces: a scene whose only term is Coriolis hands its exact velocity rotation this way
