@@ -200,11 +200,11 @@ class Forcing {
   bool rotation_only_ = false;
   bool list_stirred_ = false;  // some term reads ForceSums::stirred
   /// Every term is idle at rest (ForceTerm::idle_at_rest) and the moving bodies are listed:
-  /// after a first step over every body, a step zeroes what the last one wrote (dirty_) and
-  /// works on the moving bodies alone. The towing case: some 300 of its 5 000 floes.
+  /// after a first step over every body, a step zeroes what the last one wrote (the bodies of
+  /// loads_.loaded, which it hands on) and works on the moving bodies alone. The towing case:
+  /// some 300 of its 5 000 floes.
   bool moving_only_ = false;
-  bool have_dirty_ = false;
-  std::vector<std::int32_t> dirty_;  ///< the bodies whose sums and loads the last step may have set
+  bool have_dirty_ = false;  ///< loads_.loaded holds the bodies the last step may have set
   /// Body i's load from the sums (the per-body part of evaluate).
   void load_body(std::size_t i, const BodyStates& state, bool first_step);
   std::vector<Rot> turn_first_, turn_later_;

@@ -126,7 +126,7 @@ Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(
   list_stirred_ = std::any_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->reads_stirred(); });
   moving_only_ = list_stirred_ && std::all_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->idle_at_rest(); });
   if (list_stirred_) sums_.stirred.reserve(n);
-  if (moving_only_) dirty_.reserve(n);
+  if (moving_only_) loads_.loaded.reserve(n);
   rotated_angle_.assign(n, std::numeric_limits<double>::quiet_NaN());  // NaN: none computed yet
   cached_rate_.assign(n, 0.0);
   ahead_.assign(n, {});
@@ -264,7 +264,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
   const bool sparse = moving_only_ && have_dirty_;
   const std::span<const std::int32_t> moving = sums_.stirred;
   if (sparse) {
-    for (const std::int32_t i : dirty_) {
+    for (const std::int32_t i : loads_.loaded) {
       sums_.rate_bound[i] = {};
       sums_.q[i] = {};
       if (sums_.any_jacobian) sums_.dq[i] = {};
@@ -328,12 +328,13 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
       for (std::size_t i = begin; i < end; ++i) load_body(i, state, first_step);
     });
   }
+  // The moving bodies: the next step zeroes what they hold; after the first step, the loads
+  // name them as the only bodies with a load (those at rest zeroed above).
   if (moving_only_) {
-    dirty_.assign(moving.begin(), moving.end());
+    loads_.loaded.assign(moving.begin(), moving.end());
     have_dirty_ = true;
   }
-  loads_.listed = sparse;  // the loads of the bodies at rest zeroed, the moving ones' set
-  if (sparse) loads_.loaded.assign(moving.begin(), moving.end());
+  loads_.listed = sparse;
   note_ahead();
   return &loads_;
 }
