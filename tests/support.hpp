@@ -15,7 +15,7 @@
 
 #include "floedem/engine/registry.hpp"
 #include "floe_polygon.hpp"
-#include "forcing/force_term.hpp"
+#include "forcing/forcing.hpp"
 #include "floedem/scenario/scenario.hpp"
 
 namespace floedem::test {

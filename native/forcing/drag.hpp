@@ -74,6 +74,7 @@ class DistributedDrag final : public ForceTerm {
   bool add_rate_bound(const BodyStatesView& state, ForceSums& sums) const override;
   bool reads_stirred() const override { return calm_; }
   bool idle_at_rest() const override { return calm_; }
+  DistributedDrag* distributed_drag() override { return this; }
 
  private:
   friend class DragPass;  // reads the packed points and moments, calls add_entry (drag_pass.hpp)

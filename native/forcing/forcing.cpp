@@ -42,7 +42,7 @@
 #include <limits>
 
 #include "forcing/drag_pass.hpp"
-#include "forcing/force_term.hpp"
+#include "forcing/forcing.hpp"
 #include "parallel/thread_pool.hpp"
 
 namespace floedem {
@@ -97,11 +97,11 @@ Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(
   for (std::size_t k = 0; share_drag_pass && k < terms_.size(); ++k) {
     std::size_t end = k;
     while (end < terms_.size() && end - k < static_cast<std::size_t>(DragPass::kMaxTerms) &&
-           dynamic_cast<DistributedDrag*>(terms_[end].get()) != nullptr)
+           terms_[end]->distributed_drag() != nullptr)
       ++end;
     if (end - k < 2) continue;
     std::vector<DistributedDrag*> run;
-    for (std::size_t t = k; t < end; ++t) run.push_back(static_cast<DistributedDrag*>(terms_[t].get()));
+    for (std::size_t t = k; t < end; ++t) run.push_back(terms_[t]->distributed_drag());
     auto pass = std::make_unique<DragPass>(run, [&](std::size_t i) -> const std::vector<Vec2>& {
       return scene.bodies[i].local_polygon;
     });

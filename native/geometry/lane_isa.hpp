@@ -1,7 +1,7 @@
 #pragma once
 // The instruction sets floedem's SIMD loops are built for, one of them picked at run time for
 // all: the coloured sweeps (solver/coloured_sweeps.cpp), the narrow phase's separating-axis
-// search (solver/narrow_phase.cpp) and the drag's four-floe lanes (forcing/drag.cpp). Each
+// search (collision/narrow_phase.cpp) and the drag's four-floe lanes (forcing/drag.cpp). Each
 // build takes the same IEEE operations in the same order (no fused multiply-add:
 // -ffp-contract=off), so results are the same to the bit whichever runs (tested per loop).
 #include <vector>

@@ -10,7 +10,7 @@
 
 #include "floedem/engine/engine.hpp"
 #include "floedem/engine/step_stages.hpp"
-#include "forcing/force_term.hpp"
+#include "forcing/forcing.hpp"
 #include "floedem/scene/scene.hpp"
 #include "towing/tow.hpp"
 

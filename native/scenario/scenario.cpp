@@ -16,7 +16,7 @@
 #include "floedem/io/output.hpp"
 #include "scenario/table_reader.hpp"
 #include "floedem/scene/input_error.hpp"
-#include "scene/overlap.hpp"
+#include "collision/overlap.hpp"
 
 namespace floedem {
 

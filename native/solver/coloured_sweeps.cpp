@@ -747,8 +747,9 @@ std::size_t colour_manifolds(std::span<Manifold> manifolds, std::span<const std:
 
 
 int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& s,
-                   const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate,
-                   bool threads, bool given_order) {
+                   const SweepLimits& limits, const SweepSpace& space, const SweepOptions& options) {
+  const bool warm_start = options.warm_start, accelerate = options.accelerate, threads = options.threads;
+  const bool given_order = options.given_order;
   const Selection m{manifolds, island};
   if (space.rows.size() < 2 * m.size() || space.overflow.size() < m.size() ||
       space.body_colours.size() < s.inv_mass.size())

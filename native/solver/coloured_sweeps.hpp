@@ -29,7 +29,7 @@
 #include <span>
 #include <vector>
 
-#include "solver/contact_solver.hpp"
+#include "solver/solver_types.hpp"
 
 namespace floedem {
 
@@ -43,14 +43,14 @@ constexpr std::size_t kColouredOnThreads = 4096;
 /// of them): solve_velocities with SweepOptions::colour. `space` needs bundles and slots for
 /// the manifolds, the scene's body_colours (all zero, and left so) and, with `accelerate`,
 /// bundle_change/direction, moving_bodies and body_steps (SweepWork::reserve with colour_bodies).
-/// With `threads`, each colour's bundles are swept on the pool's threads (not from inside a
-/// loop of the pool), and a solve of 4 096 manifolds or more is packed into its bundles there
-/// too: the same impulses to the bit as without. Without `accelerate`, each
-/// colour's manifolds of two points take its first bundles unless `given_order` (the same
-/// impulses to the bit, in fewer bundle-points: coloured_sweeps.cpp).
+/// `options` as SweepOptions says (its `colour` is implied): with `threads`, each colour's
+/// bundles are swept on the pool's threads (not from inside a loop of the pool), and a solve of
+/// 4 096 manifolds or more is packed into its bundles there too: the same impulses to the bit
+/// as without. Without `accelerate`, each colour's manifolds of two points take its first
+/// bundles unless `given_order` (the same impulses to the bit, in fewer bundle-points:
+/// coloured_sweeps.cpp).
 int solve_coloured(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& bodies,
-                   const SweepLimits& limits, const SweepSpace& space, bool warm_start, bool accelerate,
-                   bool threads = false, bool given_order = false);
+                   const SweepLimits& limits, const SweepSpace& space, const SweepOptions& options);
 
 /// The colours solve_coloured gives the manifolds `island` (its first pass, made apart): each
 /// manifold's colour into colours[i] (with a flag for a manifold of two points: values for

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "solver/headroom.hpp"
+#include "engine/headroom.hpp"
 
 namespace floedem {
 

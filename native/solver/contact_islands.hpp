@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "solver/contact_solver.hpp"
+#include "solver/solver_types.hpp"
 
 namespace floedem {
 

@@ -9,7 +9,7 @@
 #include "engine/prefetch.hpp"
 #include "parallel/thread_pool.hpp"
 #include "solver/coloured_sweeps.hpp"
-#include "solver/headroom.hpp"
+#include "engine/headroom.hpp"
 #include "solver/local_law.hpp"
 #include "solver/sweep_row.hpp"
 #include "solver/sweep_schedule.hpp"
@@ -290,16 +290,14 @@ SweepSpace SweepWork::slice(std::size_t first, std::size_t count, std::size_t bu
 int solve_velocities(std::span<Manifold> manifolds, BodyArrays& s, const SweepLimits& limits, SweepSpace space,
                      SweepOptions options) {
   if (options.colour)
-    return solve_coloured(manifolds, {}, s, limits, space, options.warm_start, options.accelerate, options.threads,
-                          options.given_order);
+    return solve_coloured(manifolds, {}, s, limits, space, options);
   return solve_rows(AllRows{manifolds}, s, limits, space, options);
 }
 
 int solve_velocities(std::span<Manifold> manifolds, std::span<const std::int32_t> island, BodyArrays& s,
                      const SweepLimits& limits, SweepSpace space, SweepOptions options) {
   if (options.colour)
-    return solve_coloured(manifolds, island, s, limits, space, options.warm_start, options.accelerate,
-                          options.threads, options.given_order);
+    return solve_coloured(manifolds, island, s, limits, space, options);
   return solve_rows(IslandRows{manifolds, island}, s, limits, space, options);
 }
 
@@ -318,185 +316,6 @@ int clamp_friction(std::span<Manifold> manifolds, BodyArrays& s) {
     }
   }
   return cut;
-}
-
-double solve_positions(std::span<const Manifold> manifolds, BodyArrays& s, const NativeSettings& settings,
-                       ProjectionWork& work) {
-  // A manifold whose two bodies kept their poses, to the bit, since its gaps were last measured
-  // has the same gaps again, so it corrects nothing (had it corrected, its bodies would have
-  // moved) and its deepest gap is the one measured then: it is left as it was. Only the first
-  // sweep measures every manifold; a later one measures those near what the sweeps before it
-  // moved (in a packed field, the few deep contacts and their neighbours). The same positions
-  // and the same deepest overlap, to the bit, as measuring every manifold in every sweep.
-  //
-  // The later sweeps find those manifolds without a pass over all of them (at 10^5 floes each
-  // such pass read every manifold's bodies, out of cache, for a few hundred measured): a body
-  // that moves marks its manifolds stale (a bit each), and a sweep measures the stale ones in
-  // ascending order, marks set ahead of it this sweep, those behind it the next; a manifold's
-  // mark is cleared as it is measured, and set again if it moves its own bodies. That is the
-  // set of manifolds, in the same order, that the clocks (moved against evaluated) pick.
-  const std::size_t bodies = s.position.size();
-  const std::size_t nm = manifolds.size();
-  if (work.moved.size() != bodies) work.moved.assign(bodies, 0);
-  resize_with_headroom(work.evaluated, nm);
-  resize_with_headroom(work.depth, nm);
-  reserve_with_headroom(work.moved_bodies, bodies);
-  work.moved_bodies.clear();
-  const std::uint64_t start = work.clock;
-  bool marking = false;  // after the first sweep: moves mark their manifolds stale
-  auto mark = [&](int body) {
-    const auto b = static_cast<std::size_t>(body);
-    for (std::int32_t k = work.body_first[b]; k < work.body_first[b + 1]; ++k) {
-      const auto i = static_cast<std::size_t>(work.body_manifolds[static_cast<std::size_t>(k)]);
-      work.stale[i / 64] |= std::uint64_t{1} << (i % 64);
-    }
-  };
-  // A pose written back with other bits (however small the change) makes the body moved.
-  auto move = [&](int body, Vec2 position, double angle) {
-    if (same_bits(position.x, s.position[body].x) && same_bits(position.y, s.position[body].y) &&
-        same_bits(angle, s.angle[body]))
-      return;
-    s.position[body] = position;
-    s.angle[body] = angle;
-    s.rotation[body] = Rot::from_angle(angle);
-    if (marking)
-      mark(body);
-    else if (work.moved[static_cast<std::size_t>(body)] <= start)
-      work.moved_bodies.push_back(body);  // its first move in this call
-    work.moved[static_cast<std::size_t>(body)] = work.clock;
-  };
-  // Point k's gap at the current poses, from the material points that made the contact: the
-  // reference face's normal n_ref and point, and the incident point q; gap = (q - face).n_ref.
-  struct PointGap {
-    Vec2 n_ref, q;
-    double gap;
-  };
-  auto point_gap = [&](const Manifold& m, int k) {
-    const int ref = m.reference_is_b ? m.body_b : m.body_a;
-    const int inc = m.reference_is_b ? m.body_a : m.body_b;
-    const Vec2 n_ref = s.rotation[ref].apply(m.local_normal);
-    const Vec2 face = s.position[ref] + s.rotation[ref].apply(m.local_face_point);
-    const Vec2 q = s.position[inc] + s.rotation[inc].apply(m.points[k].local_incident);
-    return PointGap{n_ref, q, dot(q - face, n_ref)};
-  };
-  // C = beta (gap + slop), clamped to [-max_correction, 0]: a point corrects where C < 0.
-  auto correction = [&](double gap) {
-    return std::clamp(settings.position_correction * (gap + settings.allowed_penetration), -settings.max_correction,
-                      0.0);
-  };
-  // Measures manifold i's gaps and corrects them; returns its deepest gap.
-  auto measure = [&](std::size_t i) {
-    const Manifold& m = manifolds[i];
-    const int a = m.body_a, b = m.body_b;
-    work.evaluated[i] = ++work.clock;
-    double depth = 0.0;
-    const double ma = s.inv_mass[a], mb = s.inv_mass[b];
-    const double ia = s.inv_inertia[a], ib = s.inv_inertia[b];
-    for (int k = 0; k < m.point_count; ++k) {
-      const auto [n_ref, q, gap] = point_gap(m, k);
-      depth = std::max(depth, -gap);
-      // Solve K dlambda = -C with K = n.M^-1 n at the current configuration, and move
-      // positions only.
-      const double c = correction(gap);
-      if (c >= 0.0) continue;
-      const Vec2 n = m.reference_is_b ? -n_ref : n_ref;
-      const Vec2 point = q - 0.5 * gap * n_ref;
-      const Vec2 ra = point - s.position[a];
-      const Vec2 rb = point - s.position[b];
-      const double rna = cross(ra, n), rnb = cross(rb, n);
-      const double k_eff = ma + mb + ia * rna * rna + ib * rnb * rnb;
-      if (k_eff == 0.0) continue;  // two sleeping bodies, or a sleeping and a fixed one: held as they are
-      const Vec2 impulse = (-c / k_eff) * n;
-      move(a, s.position[a] - ma * impulse, s.angle[a] - ia * cross(ra, impulse));
-      move(b, s.position[b] + mb * impulse, s.angle[b] + ib * cross(rb, impulse));
-    }
-    work.depth[i] = depth;
-    return depth;
-  };
-  if (settings.position_iterations <= 0) return 0.0;
-  // The first sweep: every manifold. Its gaps are measured over the threads first, at the poses
-  // the sweep starts from, with each manifold's two bodies noted (for the lists below, which
-  // then need not read the manifolds again) and whether any point would correct. The sweep
-  // proper then goes in order and measures again only a manifold that corrects or whose bodies
-  // an earlier one moved; any other's gaps are those measured (same poses, same expressions,
-  // same bits), and it moves nothing. So the poses and depths are those of measuring every
-  // manifold in turn, on any thread count; in a settled field few manifolds correct, and the
-  // sweep's cost (reading every manifold and its bodies' poses) is shared by the threads.
-  resize_with_headroom(work.ends, 2 * nm);
-  resize_with_headroom(work.corrects, nm);
-  thread_pool().for_blocks(nm, 4096, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      // The manifold four on, every line of it asked for ahead: this pass reads the first line,
-      // each point's and the reference face's (the last), out of cache at 16k floes, and its
-      // hottest load waited on the last line (perf). A prefetch changes no value.
-      if (i + 4 < end) prefetch_lines(&manifolds[i + 4], sizeof(Manifold));
-      const Manifold& m = manifolds[i];
-      work.ends[2 * i] = m.body_a;
-      work.ends[2 * i + 1] = m.body_b;
-      double depth = 0.0;
-      bool corrects = false;
-      for (int k = 0; k < m.point_count; ++k) {
-        const double gap = point_gap(m, k).gap;
-        depth = std::max(depth, -gap);
-        corrects = corrects || correction(gap) < 0.0;
-      }
-      work.depth[i] = depth;
-      work.corrects[i] = corrects;
-    }
-  });
-  double deepest = 0.0;
-  for (std::size_t i = 0; i < nm; ++i) {
-    const auto a = static_cast<std::size_t>(work.ends[2 * i]), b = static_cast<std::size_t>(work.ends[2 * i + 1]);
-    if (work.corrects[i] || work.moved[a] > start || work.moved[b] > start) {
-      deepest = std::max(deepest, measure(i));
-    } else {
-      work.evaluated[i] = ++work.clock;  // as measure() would stamp it
-      deepest = std::max(deepest, work.depth[i]);
-    }
-  }
-  if (settings.position_iterations == 1 || deepest <= 1.5 * settings.allowed_penetration) return deepest;
-
-  // Each body's manifolds (counting sort), then the manifolds stale after the first sweep: those
-  // with a body it moved at or after their measurement (moved >= evaluated, as the clocks say).
-  work.body_first.assign(bodies + 1, 0);
-  for (std::size_t e = 0; e < 2 * nm; ++e) ++work.body_first[static_cast<std::size_t>(work.ends[e]) + 1];
-  for (std::size_t b = 0; b < bodies; ++b) work.body_first[b + 1] += work.body_first[b];
-  resize_with_headroom(work.body_manifolds, 2 * nm);
-  for (std::size_t e = 0; e < 2 * nm; ++e)
-    work.body_manifolds[static_cast<std::size_t>(work.body_first[static_cast<std::size_t>(work.ends[e])]++)] =
-        static_cast<std::int32_t>(e / 2);
-  for (std::size_t b = bodies; b > 0; --b) work.body_first[b] = work.body_first[b - 1];  // back to the starts
-  work.body_first[0] = 0;
-  const std::size_t words = (nm + 63) / 64;
-  resize_with_headroom(work.stale, words);
-  std::fill(work.stale.begin(), work.stale.begin() + static_cast<std::ptrdiff_t>(words), 0);
-  for (const std::int32_t body : work.moved_bodies) {
-    const auto b = static_cast<std::size_t>(body);
-    for (std::int32_t k = work.body_first[b]; k < work.body_first[b + 1]; ++k) {
-      const auto i = static_cast<std::size_t>(work.body_manifolds[static_cast<std::size_t>(k)]);
-      if (work.moved[b] >= work.evaluated[i]) work.stale[i / 64] |= std::uint64_t{1} << (i % 64);
-    }
-  }
-  marking = true;
-  for (int iteration = 1; iteration < settings.position_iterations; ++iteration) {
-    for (std::size_t w = 0; w < words; ++w) {
-      // The word is read again after each measure: marks set in it ahead of the one measured
-      // are this sweep's; those behind it wait for the next.
-      std::uint64_t ahead = ~std::uint64_t{0};
-      while (const std::uint64_t bits = work.stale[w] & ahead) {
-        const int j = std::countr_zero(bits);
-        const std::uint64_t bit = std::uint64_t{1} << j;
-        work.stale[w] &= ~bit;
-        ahead = j == 63 ? 0 : ~std::uint64_t{0} << (j + 1);
-        measure(64 * w + static_cast<std::size_t>(j));
-      }
-    }
-    // The deepest gap of every manifold: those not measured keep theirs (max is exact in any order).
-    deepest = 0.0;
-    for (std::size_t i = 0; i < nm; ++i) deepest = std::max(deepest, work.depth[i]);
-    if (deepest <= 1.5 * settings.allowed_penetration) break;
-  }
-  return deepest;
 }
 
 }  // namespace floedem

@@ -5,6 +5,8 @@
 #include <limits>
 #include <numeric>
 
+#include "solver/contact_solver.hpp"
+
 // Why: projected Gauss-Seidel hands a wall's reaction on by one contact per sweep, and through a
 // light floe pressed by a heavy body only the fraction m_light / m_heavy of what the heavy body
 // needs: an iceberg of mass M pressing floes of mass m against a wall needs of the order of M/m

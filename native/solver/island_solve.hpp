@@ -10,7 +10,7 @@
 #include <Eigen/SparseCore>
 
 #include "solver/contact_islands.hpp"
-#include "solver/contact_solver.hpp"
+#include "solver/solver_types.hpp"
 
 namespace floedem {
 

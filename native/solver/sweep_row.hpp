@@ -7,7 +7,7 @@
 #include <cmath>
 #include <span>
 
-#include "solver/contact_solver.hpp"
+#include "solver/solver_types.hpp"
 #include "solver/local_law.hpp"
 
 namespace floedem {

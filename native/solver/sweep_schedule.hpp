@@ -5,7 +5,7 @@
 // for applying the step; only the decisions live here.
 #include <algorithm>
 
-#include "solver/contact_solver.hpp"
+#include "solver/solver_types.hpp"
 
 namespace floedem {
 

@@ -25,8 +25,8 @@
 
 #include "contacts/collision_forces.hpp"
 #include "scenario/table_reader.hpp"
-#include "solver/broad_phase.hpp"
-#include "solver/part_set.hpp"
+#include "collision/broad_phase.hpp"
+#include "collision/part_set.hpp"
 
 namespace floedem {
 

@@ -14,14 +14,14 @@
 #include "floedem/field/field_generator.hpp"
 #include "forcing/drag.hpp"
 #include "forcing/drag_pass.hpp"
-#include "forcing/force_term.hpp"
+#include "forcing/forcing.hpp"
 #include "run/stepper.hpp"
 #include "floedem/scenario/scenario.hpp"
-#include "solver/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 #include "solver/contact_solver.hpp"
-#include "solver/narrow_phase.hpp"
+#include "collision/narrow_phase.hpp"
 #include "solver/native_settings.hpp"
-#include "solver/part_set.hpp"
+#include "collision/part_set.hpp"
 #include "parallel/thread_pool.hpp"
 #include "parallel/threads.hpp"
 
@@ -301,12 +301,7 @@ struct PackedField {
       Manifold m;
       collide_pair(pair, m);
       if (m.point_count == 0) continue;
-      m.part_a = pair.a;
-      m.part_b = pair.b;
-      m.body_a = parts.body()[pair.a];
-      m.body_b = parts.body()[pair.b];
-      m.friction = scene.contact.friction;
-      m.restitution = scene.contact.restitution;
+      name_pair(m, pair.a, pair.b, parts.body(), scene.contact);
       prepare_contact(m, bodies, scene.run.dt, scene.contact.collision_threshold);
       manifolds.push_back(m);
     }

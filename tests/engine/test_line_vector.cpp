@@ -5,8 +5,8 @@
 #include <cstdint>
 
 #include "engine/line_vector.hpp"
-#include "solver/contact_types.hpp"
-#include "solver/headroom.hpp"
+#include "collision/manifold.hpp"
+#include "engine/headroom.hpp"
 
 using namespace floedem;
 

@@ -12,7 +12,7 @@
 #include "geometry/polygon.hpp"
 #include "floedem/io/output.hpp"
 #include "floedem/scene/input_error.hpp"
-#include "scene/overlap.hpp"
+#include "collision/overlap.hpp"
 #include "support.hpp"
 
 using namespace floedem;

@@ -12,8 +12,8 @@
 
 #include "geometry/polygon.hpp"
 #include "floedem/scene/input_error.hpp"
-#include "scene/overlap.hpp"
-#include "solver/part_set.hpp"
+#include "collision/overlap.hpp"
+#include "collision/part_set.hpp"
 
 namespace {
 

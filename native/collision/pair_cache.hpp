@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "floedem/engine/state_io.hpp"
-#include "solver/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 
 namespace floedem {
 

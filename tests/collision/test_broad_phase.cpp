@@ -6,8 +6,8 @@
 
 #include "parallel/thread_pool.hpp"
 #include "parallel/threads.hpp"
-#include "solver/broad_phase.hpp"
-#include "solver/pair_cache.hpp"
+#include "collision/broad_phase.hpp"
+#include "collision/pair_cache.hpp"
 
 using namespace floedem;
 

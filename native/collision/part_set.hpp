@@ -8,7 +8,7 @@
 
 #include "engine/line_vector.hpp"
 #include "floedem/scene/scene.hpp"
-#include "solver/narrow_phase.hpp"
+#include "collision/narrow_phase.hpp"
 
 namespace floedem {
 

@@ -7,7 +7,7 @@
 #include "floedem/engine/state_io.hpp"
 #include "geometry/lane_isa.hpp"
 #include "run/stepper.hpp"
-#include "solver/narrow_phase.hpp"
+#include "collision/narrow_phase.hpp"
 #include "support.hpp"
 
 using namespace floedem;

@@ -1,10 +1,10 @@
-#include "solver/pair_cache.hpp"
+#include "collision/pair_cache.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "parallel/thread_pool.hpp"
-#include "solver/headroom.hpp"
+#include "engine/headroom.hpp"
 
 namespace floedem {
 

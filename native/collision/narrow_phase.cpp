@@ -1,4 +1,4 @@
-#include "solver/narrow_phase.hpp"
+#include "collision/narrow_phase.hpp"
 
 #include <algorithm>
 #include <limits>

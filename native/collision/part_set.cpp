@@ -1,4 +1,4 @@
-#include "solver/part_set.hpp"
+#include "collision/part_set.hpp"
 
 #include <algorithm>
 #include <atomic>

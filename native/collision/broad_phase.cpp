@@ -1,10 +1,10 @@
-#include "solver/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "parallel/thread_pool.hpp"
-#include "solver/headroom.hpp"
+#include "engine/headroom.hpp"
 
 namespace floedem {
 
@@ -39,7 +39,12 @@ void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::in
         if (consider(i, j)) out.push_back({i, j});
     return;
   }
+  build_grid(boxes);
+  collect_pairs(boxes, body, fixed, out);
+}
 
+void BroadPhase::build_grid(std::span<const Aabb> boxes) {
+  const auto n = static_cast<std::int32_t>(boxes.size());
   // World bounds and the finest cell size (median extent; coarser for a sparse scene).
   Aabb world = boxes[0];
   extents_.resize(n);
@@ -115,12 +120,21 @@ void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::in
   world_lo_ = world.lo;
   top_ = top;
   gridded_ = true;
+}
 
+void BroadPhase::collect_pairs(std::span<const Aabb> boxes, std::span<const std::int32_t> body,
+                               std::span<const std::uint8_t> fixed, std::vector<PartPair>& out) {
+  const auto n = static_cast<std::int32_t>(boxes.size());
+  const int top = top_;
+  auto consider = [&](std::int32_t i, std::int32_t j) {
+    if (body[i] == body[j] || (fixed[i] && fixed[j])) return false;
+    return boxes[i].overlaps(boxes[j]);
+  };
   // The cell, on level lv, that reports pair (i, j): the one holding the intersection's corner.
   auto reporting_cell = [&](const Level& lv, std::int32_t i, std::int32_t j) {
     const double cx = std::max(boxes[i].lo.x, boxes[j].lo.x);
     const double cy = std::max(boxes[i].lo.y, boxes[j].lo.y);
-    return lv.cell_y(cy, world.lo.y) * lv.nx + lv.cell_x(cx, world.lo.x);
+    return lv.cell_y(cy, world_lo_.y) * lv.nx + lv.cell_x(cx, world_lo_.x);
   };
 
   // Pairs, in two loops whose blocks run on the pool's threads, each block into its own list,
@@ -163,8 +177,8 @@ void BroadPhase::find_pairs(std::span<const Aabb> boxes, std::span<const std::in
       for (int l = level_of_[i] + 1; l <= top; ++l) {
         const Level& lv = levels_[l];
         if (lv.count == 0) continue;
-        const std::int64_t x0 = lv.cell_x(boxes[i].lo.x, world.lo.x), x1 = lv.cell_x(boxes[i].hi.x, world.lo.x);
-        const std::int64_t y0 = lv.cell_y(boxes[i].lo.y, world.lo.y), y1 = lv.cell_y(boxes[i].hi.y, world.lo.y);
+        const std::int64_t x0 = lv.cell_x(boxes[i].lo.x, world_lo_.x), x1 = lv.cell_x(boxes[i].hi.x, world_lo_.x);
+        const std::int64_t y0 = lv.cell_y(boxes[i].lo.y, world_lo_.y), y1 = lv.cell_y(boxes[i].hi.y, world_lo_.y);
         for (std::int64_t y = y0; y <= y1; ++y) {
           for (std::int64_t x = x0; x <= x1; ++x) {
             const std::int64_t c = y * lv.nx + x;

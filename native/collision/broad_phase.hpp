@@ -49,6 +49,11 @@ class BroadPhase {
     std::int64_t cell_x(double x, double x0) const;
     std::int64_t cell_y(double y, double y0) const;
   };
+  /// The grid over `boxes` (n >= kBruteForceBelow): its levels, cells and their parts.
+  void build_grid(std::span<const Aabb> boxes);
+  /// The pairs of the grid just built, sorted, into `out`.
+  void collect_pairs(std::span<const Aabb> boxes, std::span<const std::int32_t> body,
+                     std::span<const std::uint8_t> fixed, std::vector<PartPair>& out);
   /// Merges sorted runs (each sorted, all disjoint) into `out`, sorted.
   void merge_sorted(std::span<std::vector<PartPair>> runs, std::vector<PartPair>& out);
 

@@ -2,8 +2,11 @@
 // Narrow phase: the contact manifold of two convex polygons (up to 2 points in the plane).
 #include <cstdint>
 
+#include <span>
+
+#include "floedem/scene/scene.hpp"
 #include "geometry/sat.hpp"
-#include "solver/contact_types.hpp"
+#include "collision/manifold.hpp"
 
 namespace floedem {
 
@@ -15,6 +18,19 @@ struct PartGeometry {
   const Vec2* local_normals = nullptr;
   Transform body_transform;
 };
+
+/// Names what collide() does not set: m's parts (a < b), their bodies and the contact's
+/// material (the scene's friction and restitution).
+template <class M>
+void name_pair(M& m, std::int32_t part_a, std::int32_t part_b, std::span<const std::int32_t> part_body,
+               const ContactSettings& contact) {
+  m.part_a = part_a;
+  m.part_b = part_b;
+  m.body_a = part_body[part_a];
+  m.body_b = part_body[part_b];
+  m.friction = contact.friction;
+  m.restitution = contact.restitution;
+}
 
 /// Fills m.normal, points (point, separation, id, local_incident), reference-face data and
 /// point_count (0 when the polygons are farther apart than `margin`).

@@ -9,7 +9,7 @@
 
 #include "floe_polygon.hpp"
 #include "geometry/sat.hpp"
-#include "scene/overlap.hpp"
+#include "collision/overlap.hpp"
 
 using namespace floedem;
 

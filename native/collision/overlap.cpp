@@ -1,11 +1,11 @@
-#include "scene/overlap.hpp"
+#include "collision/overlap.hpp"
 
 #include <algorithm>
 #include <tuple>
 
 #include "geometry/polygon.hpp"
 #include "geometry/sat.hpp"
-#include "solver/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 
 namespace floedem {
 
