@@ -11,8 +11,10 @@ namespace floedem {
 namespace {
 constexpr int kBruteForceBelow = 24;  // fewer parts than this: the n^2/2 test is cheaper
 constexpr int kMaxLevels = 32;
-constexpr std::size_t kPartGrain = 4096;   // parts a block of the pairs across levels (0.2-0.5 ms)
-constexpr std::size_t kCellGrain = 32768;  // cells a block of the pairs within a level (0.1-0.3 ms)
+// Blocks large enough that the pool's hand-over is a small part of each, small enough that a
+// large field's blocks share the threads evenly.
+constexpr std::size_t kPartGrain = 4096;   // parts a block of the pairs across levels
+constexpr std::size_t kCellGrain = 32768;  // cells a block of the pairs within a level
 }  // namespace
 
 std::int64_t BroadPhase::Level::cell_x(double x, double x0) const {

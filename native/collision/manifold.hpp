@@ -45,8 +45,8 @@ struct BasicManifold {
   int point_count = 0;
   // Beside the bodies and normal, in the manifold's first 64 bytes: the coloured sweeps'
   // packing reads a one-point manifold's first 192 bytes and this, which stood in its last 64
-  // (a fourth cache line read for 62 % of the packed field's manifolds). Contact solve 4 % less
-  // time against the narrow phase's (16k field, paired runs); the same results to the bit.
+  // (a fourth cache line read for most of a packed field's manifolds, which have one point);
+  // the same results to the bit.
   double friction = 0.0;
   Point points[2];
   // Reference face in its body's frame, for the position solve.
@@ -67,8 +67,8 @@ using NarrowManifold = BasicManifold<NarrowPoint>;
 /// Copies what `from` holds into `to`: every field but the points past point_count, which are
 /// left as they were (nothing reads them). Byte ranges, not a list of fields, so a field added
 /// to the struct is copied too. A copy of the whole struct compiles to a block move (rep movs),
-/// whose start-up, and the wait of any load from the copy for its stores, were ~2 % of the 16k
-/// field's step (perf).
+/// whose start-up, and the wait of any load from the copy for its stores, cost more than the
+/// copy of what a manifold holds.
 template <class M>
 inline void copy_manifold(const M& from, M& to) {
   static_assert(std::is_trivially_copyable_v<M> && std::is_standard_layout_v<M>);
@@ -91,8 +91,8 @@ inline void fill_manifold(const NarrowManifold& from, Manifold& to) {
   to.normal = from.normal;
   to.point_count = from.point_count;
   // Field by field, as ManifoldPoint{} would leave them: `p = ManifoldPoint{}` compiled to a
-  // string store (rep stos) of the 144 bytes, whose start-up the next load waited for (perf:
-  // a sixth of the contact list's samples). A field added to ManifoldPoint must be set here.
+  // string store (rep stos) of the 144 bytes, whose start-up the next load waited for. A field
+  // added to ManifoldPoint must be set here.
   static_assert(sizeof(ManifoldPoint) == 144, "fill_manifold sets every field of ManifoldPoint");
   for (int k = 0; k < from.point_count; ++k) {
     ManifoldPoint& p = to.points[k];

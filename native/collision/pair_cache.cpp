@@ -67,9 +67,8 @@ void PairCache::find_pairs(std::span<const Aabb> boxes, std::span<const double> 
   // The pairs of this step: candidates whose step boxes overlap (candidates are sorted), found
   // by blocks of candidates on the pool's threads and joined in block order. Each candidate is
   // written to the block's next place and the count moved on by whether its boxes overlap
-  // (Aabb::overlaps_unbranched): no branch on the data, which went either way
-  // from one candidate to the next (the towing case: find_pairs 7.9 % -> 5.1 % of the run's
-  // perf samples, the same pairs).
+  // (Aabb::overlaps_unbranched): no branch on the data, which goes either way from one
+  // candidate to the next, so a branch would be mispredicted half the time.
   constexpr std::size_t kGrain = 16384;
   const std::size_t blocks = (candidates_.size() + kGrain - 1) / kGrain;
   if (overlapping_.size() < blocks) overlapping_.resize(blocks);

@@ -31,7 +31,7 @@ class PartSet {
   std::span<const std::uint8_t> kept() const { return kept_; }
 
   /// Inline: the narrow phase asks for two a pair, and out of line the call and the copy of its
-  /// result showed in the packed field's profile (perf).
+  /// result are paid for every pair of a packed field.
   PartGeometry geometry(std::int32_t part, Vec2 position, Rot rotation) const {
     const std::int32_t first = first_[part];
     return PartGeometry{ConvexView{&world_vertices_[first], &world_normals_[first], first_[part + 1] - first},

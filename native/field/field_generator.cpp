@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -475,8 +476,8 @@ std::uint64_t hilbert_index(std::uint32_t x, std::uint32_t y) {
 /// Floes numbered along a Hilbert curve through their centroids: floes in contact are then
 /// mostly near in number, so that the solver and the narrow phase, which go through contacts
 /// in the order of the floes' numbers, find both floes' data close in memory. In the sites'
-/// random order a floe's nearest neighbour lies some N/3 numbers away; the 16 000-floe speed
-/// benchmark runs 8 % faster so, 100 000 floes 16 % (native; Box2D 7 % at 16 000).
+/// random order a floe's nearest neighbour lies some N/3 numbers away, and each contact's
+/// second floe is a miss (docs/performance.md, why the code is as it is).
 void number_along_hilbert_curve(const FieldSpec& spec, std::vector<std::vector<Vec2>>& floes) {
   const double extent = std::max(spec.width, spec.height);
   auto cell = [&](double v) { return static_cast<std::uint32_t>(std::clamp(v / extent, 0.0, 1.0) * 65535.0); };
@@ -545,61 +546,68 @@ void check_field_spec(const FieldSpec& s) {
                                       " (raise d_min or shrink the domain)");
 }
 
-Field generate_field(const FieldSpec& spec) {
-  check_field_spec(spec);
-  const Domain domain = make_domain(spec, false);
-  const TruncatedPowerLaw law{spec.alpha, spec.d_min, spec.d_max};
-  Random rng(spec.seed);
+namespace {
 
-  // 1. Sizes, shuffled: site k gets floe area A_k and cell area A_k / C.
-  std::vector<double> sizes = stratified_sizes(law, spec.concentration * domain.free_area);
+/// Each floe's area and its cell's target area. Cell areas: (sqrt(A_i) + g)^2, with g such that
+/// they tile the free area F:
+///   N g^2 + 2 g sum sqrt(A_i) + sum A_i - F = 0.
+/// Shrinking cell i about its centroid to A_i then moves its edges in by about
+/// (sqrt(a_i) - sqrt(A_i)) / sqrt(pi) = g / sqrt(pi) whatever its size: the open water lies
+/// in leads of even width between the floes. (Cells of area A_i / C instead would surround
+/// the largest floes with moats, the gap growing with the floe.)
+struct CellTargets {
+  std::vector<double> floe_area, target;
+};
+CellTargets cell_targets(std::span<const double> sizes, double free_area) {
   const std::size_t n = sizes.size();
-  for (std::size_t i = n; i > 1; --i) std::swap(sizes[i - 1], sizes[rng.below(i)]);  // Fisher-Yates
-  // Cell areas: (sqrt(A_i) + g)^2, with g such that they tile the free area F:
-  //   N g^2 + 2 g sum sqrt(A_i) + sum A_i - F = 0.
-  // Shrinking cell i about its centroid to A_i then moves its edges in by about
-  // (sqrt(a_i) - sqrt(A_i)) / sqrt(pi) = g / sqrt(pi) whatever its size: the open water lies
-  // in leads of even width between the floes. (Cells of area A_i / C instead would surround
-  // the largest floes with moats, the gap growing with the floe.)
-  std::vector<double> floe_area(n), target(n);
+  CellTargets t{std::vector<double>(n), std::vector<double>(n)};
   double sum_area = 0.0, sum_root = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    floe_area[i] = area_of_diameter(sizes[i]);
-    sum_area += floe_area[i];
-    sum_root += std::sqrt(floe_area[i]);
+    t.floe_area[i] = area_of_diameter(sizes[i]);
+    sum_area += t.floe_area[i];
+    sum_root += std::sqrt(t.floe_area[i]);
   }
   const double nn = static_cast<double>(n);
-  const double gap = (-sum_root + std::sqrt(sum_root * sum_root + nn * (domain.free_area - sum_area))) / nn;
+  const double gap = (-sum_root + std::sqrt(sum_root * sum_root + nn * (free_area - sum_area))) / nn;
   double target_sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    const double r = std::sqrt(floe_area[i]) + gap;
-    target[i] = r * r;
-    target_sum += target[i];
+    const double r = std::sqrt(t.floe_area[i]) + gap;
+    t.target[i] = r * r;
+    target_sum += t.target[i];
   }
-  for (double& t : target) t *= domain.free_area / target_sum;  // exact tiling despite round-off
+  for (double& x : t.target) x *= free_area / target_sum;  // exact tiling despite round-off
+  return t;
+}
 
-  // 2. Sites: uniform in the free area.
+bool in_keep_out(const Domain& domain, Vec2 p) {
+  bool blocked = false;
+  for (const KeepOutPiece& k : domain.keep_out)
+    if (point_in_convex(k.polygon, p)) blocked = true;
+  return blocked;
+}
+
+/// n sites, uniform in the free area.
+std::vector<Vec2> place_sites(const Domain& domain, std::size_t n, Random& rng) {
   std::vector<Vec2> sites(n);
   const Vec2 span = domain.hi - domain.lo;
   for (Vec2& s : sites) {
     for (int tries = 0;; ++tries) {
       s = domain.lo + Vec2{rng.uniform() * span.x, rng.uniform() * span.y};
-      bool blocked = false;
-      for (const KeepOutPiece& k : domain.keep_out)
-        if (point_in_convex(k.polygon, s)) blocked = true;
-      if (!blocked || tries > 10000) break;
+      if (!in_keep_out(domain, s) || tries > 10000) break;
     }
   }
+  return sites;
+}
 
-  // 3. Weights, then Lloyd steps towards the centroids with the weights re-solved after each.
-  // The sites move after every solve but the last: those solves need the cells only roughly.
+/// Weights, then Lloyd steps towards the centroids with the weights re-solved after each. The
+/// sites move after every solve but the last: those solves need the cells only roughly.
+void relax_cells(const FieldSpec& spec, const Domain& domain, const std::vector<double>& target,
+                 std::vector<Vec2>& sites, std::vector<double>& w, CellSet& cells, FieldStats& stats) {
   constexpr double tolerance = 1e-6, rough_tolerance = 1e-1;
   const int lloyd_steps = static_cast<int>(std::lround(4.0 * (1.0 - spec.irregularity)));
-  std::vector<double> w(n, 0.0);
-  CellSet cells;
-  Field field;
+  const std::size_t n = sites.size();
   WeightSolve solve = solve_weights(sites, w, target, domain, cells, lloyd_steps > 0 ? rough_tolerance : tolerance);
-  field.stats.newton_iterations += solve.iterations;
+  stats.newton_iterations += solve.iterations;
   for (int step = 0; step < lloyd_steps; ++step) {
     // Sites to their centroids c_i, weights w_i - |c_i - s_i|^2: the power function of the
     // moved site then matches the old one at the centroid, |x - c_i|^2 - w'_i = |x - s_i|^2 - w_i
@@ -609,54 +617,58 @@ Field generate_field(const FieldSpec& spec) {
     // round a zone's corner): there its cell could lose all free area, which Newton cannot
     // recover from (the area's derivative vanishes with it).
     for (std::size_t i = 0; i < n; ++i) {
-      bool blocked = false;
-      for (const KeepOutPiece& k : domain.keep_out)
-        if (point_in_convex(k.polygon, cells.centroid[i])) blocked = true;
-      if (blocked) continue;
+      if (in_keep_out(domain, cells.centroid[i])) continue;
       w[i] -= length_squared(cells.centroid[i] - sites[i]);
       sites[i] = cells.centroid[i];
     }
     solve = solve_weights(sites, w, target, domain, cells, step + 1 < lloyd_steps ? rough_tolerance : tolerance);
-    field.stats.newton_iterations += solve.iterations;
+    stats.newton_iterations += solve.iterations;
   }
-  field.stats.lloyd_steps = lloyd_steps;
-  field.stats.max_cell_area_error = solve.max_relative_error;
+  stats.lloyd_steps = lloyd_steps;
+  stats.max_cell_area_error = solve.max_relative_error;
   // Unconverged weights would still give disjoint floes, but not the sizes asked for: refuse.
   if (!(solve.max_relative_error <= 1e-3))
     throw std::runtime_error("field generator: the cell areas did not converge (largest relative error " +
                              num(solve.max_relative_error) + " after " + std::to_string(solve.iterations) +
                              " Newton steps); please report the parameters and seed");
+}
 
-  // 4. Floes: each cell (minus any keep-out zone) shrunk about its centroid to its floe area.
-  std::vector<std::vector<Vec2>> polygons;
-  compute_cells(sites, w, domain, cells, &polygons);
+/// A cell reaching into a keep-out zone keeps, for each zone it meets, the larger side of one
+/// edge line of the zone (the part of the cell outside that edge is convex and clear of it).
+std::vector<Vec2> cut_keep_out(std::vector<Vec2> cell, const Domain& domain) {
+  const Aabb box = bounds_of(cell);
+  for (const KeepOutPiece& piece : domain.keep_out) {
+    if (!piece.box.overlaps(box) || intersection_moments(cell, piece.polygon).area <= 0.0) continue;
+    const std::size_t m = piece.polygon.size();
+    double best_area = -1.0;
+    LabeledPolygon best, side, in{cell, std::vector<std::int32_t>(cell.size(), -1)};
+    for (std::size_t k = 0; k < m; ++k) {
+      const Vec2 e = piece.polygon[(k + 1) % m] - piece.polygon[k];
+      const Vec2 inward{-e.y, e.x};
+      clip(in, side, inward, dot(inward, piece.polygon[k]), -1);  // outside of edge k
+      const double a = side.p.size() >= 3 ? area_moments(side.p).area : 0.0;
+      if (a > best_area) {
+        best_area = a;
+        best = side;
+      }
+    }
+    cell = best.p;
+    if (cell.size() < 3) break;
+  }
+  return cell;
+}
+
+/// Floes: each cell (minus any keep-out zone) shrunk about its centroid to its floe area.
+void shrink_cells(const FieldSpec& spec, const Domain& domain, const CellTargets& t,
+                  std::vector<std::vector<Vec2>>& polygons, Field& field) {
   const double d_min_area = area_of_diameter(spec.d_min);
+  const std::size_t n = polygons.size();
   field.floes.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     std::vector<Vec2> cell = std::move(polygons[i]);
     if (cell.size() < 3) continue;
     if (!domain.keep_out.empty()) {
-      // A cell reaching into a keep-out zone: keep the larger side of one edge line of the
-      // zone (the part of the cell outside that edge is convex and clear of the zone).
-      const Aabb box = bounds_of(cell);
-      for (const KeepOutPiece& piece : domain.keep_out) {
-        if (!piece.box.overlaps(box) || intersection_moments(cell, piece.polygon).area <= 0.0) continue;
-        const std::size_t m = piece.polygon.size();
-        double best_area = -1.0;
-        LabeledPolygon best, side, in{cell, std::vector<std::int32_t>(cell.size(), -1)};
-        for (std::size_t k = 0; k < m; ++k) {
-          const Vec2 e = piece.polygon[(k + 1) % m] - piece.polygon[k];
-          const Vec2 inward{-e.y, e.x};
-          clip(in, side, inward, dot(inward, piece.polygon[k]), -1);  // outside of edge k
-          const double a = side.p.size() >= 3 ? area_moments(side.p).area : 0.0;
-          if (a > best_area) {
-            best_area = a;
-            best = side;
-          }
-        }
-        cell = best.p;
-        if (cell.size() < 3) break;
-      }
+      cell = cut_keep_out(std::move(cell), domain);
       if (cell.size() < 3) continue;
     }
     const AreaMoments m0 = area_moments(cell);
@@ -668,10 +680,10 @@ Field generate_field(const FieldSpec& spec) {
       ++field.stats.floes_short_of_area;
       continue;
     }
-    double a = floe_area[i];
+    double a = t.floe_area[i];
     if (m.area < a) {
       // Only a keep-out cut can leave a cell short of its floe (the weights are solved to 1e-6).
-      a = m.area * floe_area[i] / target[i];
+      a = m.area * t.floe_area[i] / t.target[i];
       // A corner left by the cut, smaller than the smallest floe asked for, is no floe of the
       // distribution: dropped. Kept, it was a body hundreds of times lighter than its
       // neighbours (a 0.6 m fragment of 289 kg wedged between the iceberg and 5e4 kg floes,
@@ -687,15 +699,10 @@ Field generate_field(const FieldSpec& spec) {
     for (std::size_t k = 0; k < cell.size(); ++k) floe[k] = m.centroid + shrink * (cell[k] - m.centroid);
     field.floes.push_back(std::move(floe));
   }
+}
 
-  number_along_hilbert_curve(spec, field.floes);
-
-  // Thickness, drawn in floe order after the geometry (so a thickness change leaves shapes alone).
-  field.thickness.reserve(field.floes.size());
-  Random thickness_rng(spec.seed ^ 0x9e3779b97f4a7c15ULL);
-  for (std::size_t i = 0; i < field.floes.size(); ++i) field.thickness.push_back(draw_thickness(spec.thickness, thickness_rng));
-
-  // Statistics of what was made, measured on the polygons.
+/// Statistics of what was made, measured on the polygons.
+void measure_field(const FieldSpec& spec, const Domain& domain, Field& field) {
   FieldStats& st = field.stats;
   st.floes = field.floes.size();
   st.free_area = domain.free_area;
@@ -708,6 +715,40 @@ Field generate_field(const FieldSpec& spec) {
   }
   st.concentration = st.ice_area / st.free_area;
   st.fit = fit_truncated_power_law(d, spec.d_min, spec.d_max);
+}
+
+}  // namespace
+
+Field generate_field(const FieldSpec& spec) {
+  check_field_spec(spec);
+  const Domain domain = make_domain(spec, false);
+  const TruncatedPowerLaw law{spec.alpha, spec.d_min, spec.d_max};
+  Random rng(spec.seed);
+
+  // 1. Sizes, shuffled: site k gets floe area A_k and cell area A_k / C.
+  std::vector<double> sizes = stratified_sizes(law, spec.concentration * domain.free_area);
+  const std::size_t n = sizes.size();
+  for (std::size_t i = n; i > 1; --i) std::swap(sizes[i - 1], sizes[rng.below(i)]);  // Fisher-Yates
+  const CellTargets targets = cell_targets(sizes, domain.free_area);
+  // 2. Sites: uniform in the free area.
+  std::vector<Vec2> sites = place_sites(domain, n, rng);
+  // 3. Weights and Lloyd steps.
+  std::vector<double> w(n, 0.0);
+  CellSet cells;
+  Field field;
+  relax_cells(spec, domain, targets.target, sites, w, cells, field.stats);
+  // 4. Floes.
+  std::vector<std::vector<Vec2>> polygons;
+  compute_cells(sites, w, domain, cells, &polygons);
+  shrink_cells(spec, domain, targets, polygons, field);
+
+  number_along_hilbert_curve(spec, field.floes);
+
+  // Thickness, drawn in floe order after the geometry (so a thickness change leaves shapes alone).
+  field.thickness.reserve(field.floes.size());
+  Random thickness_rng(spec.seed ^ 0x9e3779b97f4a7c15ULL);
+  for (std::size_t i = 0; i < field.floes.size(); ++i) field.thickness.push_back(draw_thickness(spec.thickness, thickness_rng));
+  measure_field(spec, domain, field);
   return field;
 }
 

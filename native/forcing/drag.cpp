@@ -339,8 +339,8 @@ static_assert(sizeof(v4d) == sizeof(double) * kQuad);
 
 // The slots of a few edges or triangles on, asked for ahead of their loads: in the 16k field's
 // step a drag term's slots (about 5 MB) come back from memory each step, after the rest of the
-// step has moved them out of cache, and the loop's first load of each slot waited for them
-// (perf: over a third of the loop's samples). The next group's slots follow this one's, so
+// step has moved them out of cache, and the loop's first load of each slot waited for them.
+// The next group's slots follow this one's, so
 // near a group's end this fetches the next one's first. A prefetch changes no value.
 // BM_DragQuadrature, whose slots stay in cache between calls, does not show the gain.
 template <class Slot>

@@ -176,8 +176,7 @@ class DistributedDrag final : public ForceTerm {
   mutable bool lanes_packed_ = false;
   mutable std::vector<LaneGroup> groups_;
   // Each lane's slab moments (rate bound), group by group: read in the groups' order, where
-  // reading them from quiet_ by entry (entries sorted within windows of 64) waited for memory
-  // (perf: two thirds of the rate bound's samples, at 16k floes).
+  // reading them from quiet_ by entry (entries sorted within windows of 64) waited for memory.
   mutable std::vector<std::array<double, 4>> lane_moments_;
   mutable std::vector<FormSlot> form_lanes_;
   mutable std::vector<SkinSlot> skin_lanes_;

@@ -198,6 +198,64 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     }
     return &loads_;
   }
+  const BodyStatesView at = state_seen(state);
+  place_rotations(at, rotations);
+  sums_.stirred.clear();
+  if (list_stirred_)
+    for (std::size_t i = 0; i < hot_.size(); ++i) {
+      const Vec2 v = at.velocity[i];
+      if (v.x != 0.0 || v.y != 0.0 || at.angular_velocity[i] != 0.0) sums_.stirred.push_back(static_cast<std::int32_t>(i));
+    }
+  // Moving bodies alone (moving_only_): every term is idle at rest, so a body at rest gets
+  // Q = +0, no Jacobian and no rate bound, hence no load (load_body's first skip), and its
+  // entries stay as the full path would set them once those the last step wrote are zeroed.
+  // The same sums and loads to the bit.
+  const bool sparse = moving_only_ && have_dirty_;
+  const std::span<const std::int32_t> moving = sums_.stirred;
+  if (sparse) {
+    for (const std::int32_t i : loads_.loaded) {
+      sums_.rate_bound[i] = {};
+      sums_.q[i] = {};
+      if (sums_.any_jacobian) sums_.dq[i] = {};
+      loads_.force[i] = {};
+      loads_.torque[i] = 0.0;
+    }
+  }
+  choose_jacobians(at, sparse);
+  if (sums_.any_rotation) std::fill(sums_.rotation_rate.begin(), sums_.rotation_rate.end(), 0.0);
+  sums_.any_jacobian = sums_.any_rotation = false;
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    if (drag_pass_ && k == pass_first_) {  // the run's terms, the shared floes in one pass
+      drag_pass_->add(at, time, sums_);
+      k += pass_count_ - 1;
+      continue;
+    }
+    terms_[k]->add(at, time, sums_);
+  }
+
+  const bool first_step = time == 0.0;
+  // Per body, independent: blocks on the pool's threads (the same result on any number).
+  if (sparse) {
+    thread_pool().for_blocks(moving.size(), 2048, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) load_body(static_cast<std::size_t>(moving[k]), state, first_step);
+    });
+  } else {
+    thread_pool().for_blocks(hot_.size(), 2048, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) load_body(i, state, first_step);
+    });
+  }
+  // The moving bodies: the next step zeroes what they hold; after the first step, the loads
+  // name them as the only bodies with a load (those at rest zeroed above).
+  if (moving_only_) {
+    loads_.loaded.assign(moving.begin(), moving.end());
+    have_dirty_ = true;
+  }
+  loads_.listed = sparse;
+  note_ahead();
+  return &loads_;
+}
+
+BodyStatesView Forcing::state_seen(const BodyStates& state) {
   // A prescribed body feels the forcing at the velocity it will have over the step.
   // Only the velocities are copied (the terms read positions and angles from the state).
   BodyStatesView at = state;
@@ -230,48 +288,32 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
       }
     });
   }
+  return at;
+}
 
+void Forcing::place_rotations(const BodyStatesView& at, std::span<const Rot> rotations) {
   // Per body: its rotation, the engine's where it has them (the same Rot::from_angle of the
-  // same angle: a copy, not a sine and cosine per body, 1.5 % of the 16k field's step), else
-  // made where it turned (blocks on the pool's threads); then, in body order, the list of the
-  // bodies that move.
+  // same angle: a copy, not a sine and cosine per body), else made where it turned (blocks on
+  // the pool's threads).
   if (rotations.size() == hot_.size()) {
     std::copy(rotations.begin(), rotations.end(), sums_.rotation.begin());
     rotations_copied_ = true;
-  } else {
-    if (rotations_copied_) {  // the angles the rotations were made for are not known
-      std::fill(rotated_angle_.begin(), rotated_angle_.end(), std::numeric_limits<double>::quiet_NaN());
-      rotations_copied_ = false;
-    }
-    thread_pool().for_blocks(hot_.size(), 4096, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i)
-        if (at.angle[i] != rotated_angle_[i]) {  // the body turned (or the first step)
-          sums_.rotation[i] = Rot::from_angle(at.angle[i]);
-          rotated_angle_[i] = at.angle[i];
-        }
-    });
+    return;
   }
-  sums_.stirred.clear();
-  if (list_stirred_)
-    for (std::size_t i = 0; i < hot_.size(); ++i) {
-      const Vec2 v = at.velocity[i];
-      if (v.x != 0.0 || v.y != 0.0 || at.angular_velocity[i] != 0.0) sums_.stirred.push_back(static_cast<std::int32_t>(i));
-    }
-  // Moving bodies alone (moving_only_): every term is idle at rest, so a body at rest gets
-  // Q = +0, no Jacobian and no rate bound, hence no load (load_body's first skip), and its
-  // entries stay as the full path would set them once those the last step wrote are zeroed.
-  // The same sums and loads to the bit.
-  const bool sparse = moving_only_ && have_dirty_;
-  const std::span<const std::int32_t> moving = sums_.stirred;
-  if (sparse) {
-    for (const std::int32_t i : loads_.loaded) {
-      sums_.rate_bound[i] = {};
-      sums_.q[i] = {};
-      if (sums_.any_jacobian) sums_.dq[i] = {};
-      loads_.force[i] = {};
-      loads_.torque[i] = 0.0;
-    }
+  if (rotations_copied_) {  // the angles the rotations were made for are not known
+    std::fill(rotated_angle_.begin(), rotated_angle_.end(), std::numeric_limits<double>::quiet_NaN());
+    rotations_copied_ = false;
   }
+  thread_pool().for_blocks(hot_.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (at.angle[i] != rotated_angle_[i]) {  // the body turned (or the first step)
+        sums_.rotation[i] = Rot::from_angle(at.angle[i]);
+        rotated_angle_[i] = at.angle[i];
+      }
+  });
+}
+
+void Forcing::choose_jacobians(const BodyStatesView& at, bool sparse) {
   // Which bodies need D: where the terms' bound on dt |D| / M stays below the explicit limit,
   // load_body would find the body explicit whatever D is, so D is not computed (the terms then
   // skip its nine products per quadrature point). The margin covers rounding in the sums.
@@ -296,6 +338,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     sums_.jacobian[i] = !bounded || (h.moves && dt_ * rate * (1.0 + 1e-6) > kExplicitLimit);
   };
   if (sparse) {
+    const std::span<const std::int32_t> moving = sums_.stirred;
     thread_pool().for_blocks(moving.size(), 8192, [&](std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) needs_jacobian(static_cast<std::size_t>(moving[k]));
     });
@@ -306,37 +349,6 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     std::fill(sums_.q.begin(), sums_.q.end(), std::array<double, 3>{});
     if (sums_.any_jacobian) std::fill(sums_.dq.begin(), sums_.dq.end(), std::array<double, 9>{});
   }
-  if (sums_.any_rotation) std::fill(sums_.rotation_rate.begin(), sums_.rotation_rate.end(), 0.0);
-  sums_.any_jacobian = sums_.any_rotation = false;
-  for (std::size_t k = 0; k < terms_.size(); ++k) {
-    if (drag_pass_ && k == pass_first_) {  // the run's terms, the shared floes in one pass
-      drag_pass_->add(at, time, sums_);
-      k += pass_count_ - 1;
-      continue;
-    }
-    terms_[k]->add(at, time, sums_);
-  }
-
-  const bool first_step = time == 0.0;
-  // Per body, independent: blocks on the pool's threads (the same result on any number).
-  if (sparse) {
-    thread_pool().for_blocks(moving.size(), 2048, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k) load_body(static_cast<std::size_t>(moving[k]), state, first_step);
-    });
-  } else {
-    thread_pool().for_blocks(hot_.size(), 2048, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) load_body(i, state, first_step);
-    });
-  }
-  // The moving bodies: the next step zeroes what they hold; after the first step, the loads
-  // name them as the only bodies with a load (those at rest zeroed above).
-  if (moving_only_) {
-    loads_.loaded.assign(moving.begin(), moving.end());
-    have_dirty_ = true;
-  }
-  loads_.listed = sparse;
-  note_ahead();
-  return &loads_;
 }
 
 void Forcing::load_body(std::size_t i, const BodyStates& state, bool first_step) {

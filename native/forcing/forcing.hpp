@@ -94,6 +94,13 @@ class Forcing {
   /// some 300 of its 5 000 floes.
   bool moving_only_ = false;
   bool have_dirty_ = false;  ///< loads_.loaded holds the bodies the last step may have set
+  /// The state the terms see: the prescribed bodies at their velocities over the step, the
+  /// free bodies at their mid-step velocities (evaluate's parts, in its order).
+  BodyStatesView state_seen(const BodyStates& state);
+  /// Each body's rotation into the sums.
+  void place_rotations(const BodyStatesView& at, std::span<const Rot> rotations);
+  /// The terms' rate bounds, and from them which bodies need the Jacobian D; the sums zeroed.
+  void choose_jacobians(const BodyStatesView& at, bool sparse);
   /// Body i's load from the sums (the per-body part of evaluate).
   void load_body(std::size_t i, const BodyStates& state, bool first_step);
   std::vector<Rot> turn_first_, turn_later_;

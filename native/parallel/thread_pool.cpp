@@ -11,7 +11,8 @@ namespace {
 
 // How long a thread watches for news before it sleeps: a worker for the next job, the caller
 // for the workers still inside a job. Longer than most serial stretches between two loops of
-// a step (broad phase, island grouping: 0.05-0.3 ms on the 16k field), far shorter than a step.
+// a step (broad phase, island grouping), far shorter than a step of a field worth two threads
+// (docs/performance.md gives both).
 constexpr auto kSpin = std::chrono::microseconds(200);
 
 /// True as soon as ready() is, false if it is not within kSpin.

@@ -5,7 +5,7 @@
 // count or on which thread takes which block: a run with FLOEDEM_THREADS=1 and one with 16 are
 // identical to the bit (tests/run/test_determinism.cpp).
 //
-// A step runs some fifteen loops of 0.05 to 2 ms each, with serial work between them, so what a
+// A step runs some fifteen short loops, with serial work between them, so what a
 // loop costs beyond its blocks decides whether a second thread helps at all. Here:
 //  - a worker joins a job only while it is open, and the caller closes it as soon as every
 //    block is claimed: a worker still waking when the caller has done all the blocks alone

@@ -132,167 +132,212 @@ std::int64_t read_checkpoint_header(StateReader& in) {
 
 }  // namespace
 
-RunSummary run_scene(const Scene& scene, const RunOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  Stepper stepper(scene, options.engine);
-  RunInfo info;
-  for (const auto name : stepper.forcing().names()) info.forcing_terms.emplace_back(name);
-  info.floedem_version = version();
-  TowMonitor& tow = stepper.tow();
-  ContactLoads loads(scene);
-  CollisionTracker collisions(scene, duration_model_of(stepper.engine().info()));
-  EnergyBalance energy(scene);
-  Tally tally;
-  RunSummary& summary = tally.summary;
-  summary.engine = options.engine;
-  const std::int64_t steps = scene.run.steps();
+namespace {
 
-  // A fresh run, or one continued from its checkpoint: every part reads back its state, in
-  // the order of checkpoint() below, and the file is cut back to the rows written by then.
-  std::int64_t first = 1;
-  std::unique_ptr<Recorder> recorder_owner;
-  if (options.resume_state) {
-    const std::vector<std::uint8_t>& bytes = *options.resume_state;
+/// One run of a scene: its parts, and the stages of run_scene (open, the steps, the end).
+class SceneRun {
+ public:
+  SceneRun(const Scene& scene, const RunOptions& options)
+      : scene_(scene),
+        options_(options),
+        stepper_(scene, options.engine),
+        tow_(stepper_.tow()),
+        loads_(scene),
+        collisions_(scene, duration_model_of(stepper_.engine().info())),
+        energy_(scene),
+        summary_(tally_.summary),
+        steps_(scene.run.steps()),
+        // Without forcing or towing nothing may add energy: the largest kinetic energy of the
+        // run is then a check (recorded, summary_max_kinetic_energy); with forcing it is not,
+        // and not computed.
+        track_energy_(stepper_.forcing().names().empty() && !tow_.active()) {
+    for (const auto name : stepper_.forcing().names()) info_.forcing_terms.emplace_back(name);
+    info_.floedem_version = version();
+    summary_.engine = options.engine;
+  }
+
+  /// A fresh run, or one continued from its checkpoint: every part reads back its state, in
+  /// the order of checkpoint() below, and the file is cut back to the rows written by then.
+  /// Returns the first step to make.
+  std::int64_t open() {
+    if (!options_.resume_state) {
+      recorder_ = std::make_unique<Recorder>(options_.output, scene_, stepper_.engine().info(), info_);
+      summary_.kinetic_energy_start = kinetic_energy(scene_, stepper_.state());
+      summary_.max_kinetic_energy = summary_.kinetic_energy_start;
+      constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+      if (tow_.active()) recorder_->write_tow(0.0, {{nan, nan}, {nan, nan}, {nan, nan}, tow_.tug_position(0.0)});  // no step yet
+      recorder_->write_frame(0.0, stepper_.state());
+      return 1;
+    }
+    const std::vector<std::uint8_t>& bytes = *options_.resume_state;
     StateReader in(bytes.data(), bytes.size());
     const std::int64_t at = read_checkpoint_header(in);
-    if (at > steps)
-      throw InputError(scene.source_path + ": run.duration " + setting_text(scene.run.duration) +
-                       " s ends before the checkpoint (t = " + setting_text(static_cast<double>(at) * scene.run.dt) +
+    if (at > steps_)
+      throw InputError(scene_.source_path + ": run.duration " + setting_text(scene_.run.duration) +
+                       " s ends before the checkpoint (t = " + setting_text(static_cast<double>(at) * scene_.run.dt) +
                        " s) that the run continues from");
     const RecordedRows rows = restore_rows(in);
-    stepper.restore(in);
-    tally.restore(in);
-    collisions.restore(in);
-    loads.restore(in);
-    energy.restore(in);
+    stepper_.restore(in);
+    tally_.restore(in);
+    collisions_.restore(in);
+    loads_.restore(in);
+    energy_.restore(in);
     if (in.left() != 0) throw StateError("checkpoint: more state than this run reads");
-    if (stepper.steps_done() != at) throw StateError("checkpoint: the engine's step count differs from the run's");
-    first = at + 1;
-    recorder_owner = std::make_unique<Recorder>(options.output, scene, info, rows);
-  } else {
-    recorder_owner = std::make_unique<Recorder>(options.output, scene, stepper.engine().info(), info);
-    summary.kinetic_energy_start = kinetic_energy(scene, stepper.state());
-    summary.max_kinetic_energy = summary.kinetic_energy_start;
-    constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-    if (tow.active()) recorder_owner->write_tow(0.0, {{nan, nan}, {nan, nan}, {nan, nan}, tow.tug_position(0.0)});  // no step yet
-    recorder_owner->write_frame(0.0, stepper.state());
+    if (stepper_.steps_done() != at) throw StateError("checkpoint: the engine's step count differs from the run's");
+    recorder_ = std::make_unique<Recorder>(options_.output, scene_, info_, rows);
+    return at + 1;
   }
-  Recorder& recorder = *recorder_owner;
 
-  std::vector<CollisionRow> ended;
-  auto record_collisions = [&] {
-    for (const CollisionRow& r : ended) summary.max_peak_force = std::max(summary.max_peak_force, r.peak_force);
-    summary.collision_events += static_cast<std::int64_t>(ended.size());
-    recorder.write_collisions(ended);
-    ended.clear();
-  };
+  /// Step k, and the rows it writes.
+  void step(std::int64_t k) {
+    Recorder& recorder = *recorder_;
+    energy_.before_step(stepper_.state());
+    stepper_.step();
+    const double t_end = stepper_.time();
+    const BodyStates& state = stepper_.state();
+    if (!finite_state(state))
+      throw SolverFailure("non-finite body state at step " + std::to_string(k) + " (t = " + std::to_string(t_end) +
+                          " s); output so far kept in " + recorder.partial_path());
+    const auto contacts = stepper_.contacts();
+    energy_.after_step(stepper_.last_loads(), state, contacts);
+    for (const ContactRecord& c : contacts) {
+      ++(c.kind == ContactKind::collision ? summary_.collision_impulses : summary_.resting_impulses);
+      if (c.separation < 0.0) {
+        summary_.max_penetration = std::max(summary_.max_penetration, -c.separation);
+        tally_.overlap_sum -= c.separation;
+        ++tally_.overlaps;
+      }
+    }
+    // Stability figures for the stress suite: cheap (one pass over the bodies).
+    for (const Vec2 v : state.velocity) summary_.max_speed_seen = std::max(summary_.max_speed_seen, length_squared(v));
+    if (track_energy_)
+      summary_.max_kinetic_energy = std::max(summary_.max_kinetic_energy, kinetic_energy(scene_, state));
+    recorder.write_contacts(t_end, contacts);
+    collisions_.observe(t_end, contacts, state, ended_);
+    if (!ended_.empty()) record_collisions();
+    // Rows on their cadence here; the last step's rows off the cadence after the loop, so
+    // that a checkpoint is the same whether the run ends there or goes on (--resume with a
+    // longer run.duration).
+    if (tow_.active() && k % scene_.tow_every() == 0) recorder.write_tow(t_end, tow_.take_frame(t_end));
+    if (loads_.active()) {
+      loads_.after_step(contacts);
+      if (k % scene_.load_every() == 0) recorder.write_loads(t_end, loads_.take_row());
+    }
+    if (k % scene_.run.output_every == 0) {
+      recorder.write_frame(t_end, state);
+      if (checkpoints_ && recorder.frames() % recorder.frame_chunk() == 0) checkpoint(k);
+    }
+  }
+
+  /// The last rows, the summary, and the file made whole.
+  RunSummary finish(std::chrono::steady_clock::time_point start) {
+    Recorder& recorder = *recorder_;
+    const BodyStates& state = stepper_.state();
+    const double t_end = stepper_.time();
+    if (tow_.active() && steps_ % scene_.tow_every() != 0) recorder.write_tow(t_end, tow_.take_frame(t_end));
+    if (loads_.active() && steps_ % scene_.load_every() != 0) recorder.write_loads(t_end, loads_.take_row());
+    if (steps_ % scene_.run.output_every != 0) recorder.write_frame(t_end, state);
+    collisions_.finish(state, ended_);
+    record_collisions();
+    RunSummary& summary = summary_;
+    summary.steps = steps_;
+    summary.kinetic_energy_end = kinetic_energy(scene_, state);
+    summary.max_speed_seen = std::sqrt(summary.max_speed_seen);
+    summary.mean_penetration = tally_.overlaps > 0 ? tally_.overlap_sum / static_cast<double>(tally_.overlaps) : 0.0;
+    if (!track_energy_) summary.max_kinetic_energy = std::numeric_limits<double>::quiet_NaN();
+    for (const Vec2 v : state.velocity) summary.max_speed = std::max(summary.max_speed, length(v));
+    summary.work_of_loads = energy_.work_of_loads();
+    summary.work_of_paths = energy_.work_of_paths();
+    summary.contact_work = energy_.contact_work();
+    summary.max_relative_energy_gain = energy_.max_relative_gain();
+    summary.frames = recorder.frames();
+    summary.contact_rows = recorder.contact_rows();
+    summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    recorder.update_engine_info(stepper_.engine().info());
+    recorder.finish({{"steps", static_cast<double>(summary.steps)},
+                     {"kinetic_energy_start", summary.kinetic_energy_start},
+                     {"kinetic_energy_end", summary.kinetic_energy_end},
+                     {"collision_impulses", static_cast<double>(summary.collision_impulses)},
+                     {"resting_impulses", static_cast<double>(summary.resting_impulses)},
+                     {"collision_events", static_cast<double>(summary.collision_events)},
+                     {"max_peak_force", summary.max_peak_force},
+                     {"max_speed", summary.max_speed_seen},
+                     {"max_penetration", summary.max_penetration},
+                     {"mean_penetration", summary.mean_penetration},
+                     {"max_kinetic_energy", summary.max_kinetic_energy},
+                     {"work_of_loads", summary.work_of_loads},
+                     {"work_of_paths", summary.work_of_paths},
+                     {"contact_work", summary.contact_work},
+                     {"max_relative_energy_gain", summary.max_relative_energy_gain}});
+    // No wall time in the file: two runs of one scene give bit-identical files.
+    summary.headline = read_run_headline(options_.output);
+    return summary;
+  }
+
+ private:
+  void record_collisions() {
+    for (const CollisionRow& r : ended_) summary_.max_peak_force = std::max(summary_.max_peak_force, r.peak_force);
+    summary_.collision_events += static_cast<std::int64_t>(ended_.size());
+    recorder_->write_collisions(ended_);
+    ended_.clear();
+  }
+
   // A checkpoint after each full chunk of frames (when the frames are written anyway): the
   // state after step k and the rows written by then. Engines that cannot save their state
   // get none (--resume then runs them again from the start).
-  StateWriter checkpoint_bytes;
-  bool checkpoints = true;
-  auto checkpoint = [&](std::int64_t k) {
-    StateWriter& out = checkpoint_bytes;
+  void checkpoint(std::int64_t k) {
+    StateWriter& out = checkpoint_bytes_;
     out.clear();
     out.tag("floedem checkpoint");
     out.value(kCheckpointFormat);
     out.value(k);
-    save_rows(out, recorder.rows());
-    if (!stepper.save(out)) {
-      checkpoints = false;
+    save_rows(out, recorder_->rows());
+    if (!stepper_.save(out)) {
+      checkpoints_ = false;
       return;
     }
-    ++tally.checkpoints;
-    tally.save(out);
-    collisions.save(out);
-    loads.save(out);
-    energy.save(out);
-    recorder.write_checkpoint(tally.checkpoints - 1, k, out.bytes());
-  };
+    ++tally_.checkpoints;
+    tally_.save(out);
+    collisions_.save(out);
+    loads_.save(out);
+    energy_.save(out);
+    recorder_->write_checkpoint(tally_.checkpoints - 1, k, out.bytes());
+  }
+
+  const Scene& scene_;
+  const RunOptions& options_;
+  Stepper stepper_;
+  RunInfo info_;
+  TowMonitor& tow_;
+  ContactLoads loads_;
+  CollisionTracker collisions_;
+  EnergyBalance energy_;
+  Tally tally_;
+  RunSummary& summary_;
+  const std::int64_t steps_;
+  const bool track_energy_;
+  std::unique_ptr<Recorder> recorder_;
+  std::vector<CollisionRow> ended_;
+  StateWriter checkpoint_bytes_;
+  bool checkpoints_ = true;
+};
+
+}  // namespace
+
+RunSummary run_scene(const Scene& scene, const RunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SceneRun run(scene, options);
+  const std::int64_t first = run.open();
+  const std::int64_t steps = scene.run.steps();
   Progress progress(options.progress, first - 1);
-  // Without forcing or towing nothing may add energy: the largest kinetic energy of the run is
-  // then a check (recorded, summary_max_kinetic_energy); with forcing it is not, and not computed.
-  const bool track_energy = stepper.forcing().names().empty() && !tow.active();
   const std::int64_t kill_at = kill_at_step();
   for (std::int64_t k = first; k <= steps; ++k) {
-    energy.before_step(stepper.state());
-    stepper.step();
-    const double t_end = stepper.time();
-    const BodyStates& state = stepper.state();
-    if (!finite_state(state))
-      throw SolverFailure("non-finite body state at step " + std::to_string(k) + " (t = " + std::to_string(t_end) +
-                          " s); output so far kept in " + recorder.partial_path());
-    const auto contacts = stepper.contacts();
-    energy.after_step(stepper.last_loads(), state, contacts);
-    for (const ContactRecord& c : contacts) {
-      ++(c.kind == ContactKind::collision ? summary.collision_impulses : summary.resting_impulses);
-      if (c.separation < 0.0) {
-        summary.max_penetration = std::max(summary.max_penetration, -c.separation);
-        tally.overlap_sum -= c.separation;
-        ++tally.overlaps;
-      }
-    }
-    // Stability figures for the stress suite: cheap (one pass over the bodies).
-    for (const Vec2 v : state.velocity) summary.max_speed_seen = std::max(summary.max_speed_seen, length_squared(v));
-    if (track_energy) summary.max_kinetic_energy = std::max(summary.max_kinetic_energy, kinetic_energy(scene, state));
-    recorder.write_contacts(t_end, contacts);
-    collisions.observe(t_end, contacts, state, ended);
-    if (!ended.empty()) record_collisions();
-    // Rows on their cadence here; the last step's rows off the cadence after the loop, so
-    // that a checkpoint is the same whether the run ends there or goes on (--resume with a
-    // longer run.duration).
-    if (tow.active() && k % scene.tow_every() == 0) recorder.write_tow(t_end, tow.take_frame(t_end));
-    if (loads.active()) {
-      loads.after_step(contacts);
-      if (k % scene.load_every() == 0) recorder.write_loads(t_end, loads.take_row());
-    }
-    if (k % scene.run.output_every == 0) {
-      recorder.write_frame(t_end, state);
-      if (checkpoints && recorder.frames() % recorder.frame_chunk() == 0) checkpoint(k);
-    }
+    run.step(k);
     progress.update(k, steps);
     if (k == kill_at) std::raise(SIGKILL);
   }
   progress.done();
-  const BodyStates& state = stepper.state();
-  const double t_end = stepper.time();
-  if (tow.active() && steps % scene.tow_every() != 0) recorder.write_tow(t_end, tow.take_frame(t_end));
-  if (loads.active() && steps % scene.load_every() != 0) recorder.write_loads(t_end, loads.take_row());
-  if (steps % scene.run.output_every != 0) recorder.write_frame(t_end, state);
-  collisions.finish(state, ended);
-  record_collisions();
-  summary.steps = steps;
-  summary.kinetic_energy_end = kinetic_energy(scene, state);
-  summary.max_speed_seen = std::sqrt(summary.max_speed_seen);
-  summary.mean_penetration = tally.overlaps > 0 ? tally.overlap_sum / static_cast<double>(tally.overlaps) : 0.0;
-  if (!track_energy) summary.max_kinetic_energy = std::numeric_limits<double>::quiet_NaN();
-  for (const Vec2 v : state.velocity) summary.max_speed = std::max(summary.max_speed, length(v));
-  summary.work_of_loads = energy.work_of_loads();
-  summary.work_of_paths = energy.work_of_paths();
-  summary.contact_work = energy.contact_work();
-  summary.max_relative_energy_gain = energy.max_relative_gain();
-  summary.frames = recorder.frames();
-  summary.contact_rows = recorder.contact_rows();
-  summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  recorder.update_engine_info(stepper.engine().info());
-  recorder.finish({{"steps", static_cast<double>(summary.steps)},
-                   {"kinetic_energy_start", summary.kinetic_energy_start},
-                   {"kinetic_energy_end", summary.kinetic_energy_end},
-                   {"collision_impulses", static_cast<double>(summary.collision_impulses)},
-                   {"resting_impulses", static_cast<double>(summary.resting_impulses)},
-                   {"collision_events", static_cast<double>(summary.collision_events)},
-                   {"max_peak_force", summary.max_peak_force},
-                   {"max_speed", summary.max_speed_seen},
-                   {"max_penetration", summary.max_penetration},
-                   {"mean_penetration", summary.mean_penetration},
-                   {"max_kinetic_energy", summary.max_kinetic_energy},
-                   {"work_of_loads", summary.work_of_loads},
-                   {"work_of_paths", summary.work_of_paths},
-                   {"contact_work", summary.contact_work},
-                   {"max_relative_energy_gain", summary.max_relative_energy_gain}});
-  // No wall time in the file: two runs of one scene give bit-identical files.
-  summary.headline = read_run_headline(options.output);
-  return summary;
+  return run.finish(start);
 }
 
 std::string format_summary(const Scene& scene, const RunSummary& s, const std::string& output) {

@@ -186,8 +186,7 @@ FLOEDEM_LANES void finish(const SweepBundle& b, const BundleRun& r, Vec2* v, dou
 // would (|dP|^2 added in bundle and point order; a maximum does not depend on order), so the
 // sweep is the same to the bit as one bundle at a time.
 // The bundles are read and written in order, ten times a step, and at 100k floes they come
-// from memory (some 50 MB): the sweep waited on each bundle's first loads (perf: a third of the
-// 100k sweep's samples on the first loads of a bundle and its points). Each pair of bundles
+// from memory (some 50 MB): the sweep would wait on each bundle's first loads. Each pair of bundles
 // asks for the pair two on (bundles four on, 3 KB ahead; eight on gave the same). A prefetch
 // changes no value; in cache it costs a little.
 constexpr std::size_t kSweepAhead = 4;
@@ -409,8 +408,8 @@ constexpr std::int32_t kEmptiesSecond = 1 << 30;       // in a slot: empty_secon
 // applies the warm start manifold by manifold in the given order (it writes only the bodies'
 // velocities, which the lanes do not read: the same velocities as the loop's, whatever the
 // threads). `place` keeps each bundle's point count in `points` (a byte a bundle, in cache:
-// written into each 768-byte bundle, it was a miss a manifold on this one thread, the largest
-// serial part of the 16k field's solve on two threads: perf), and the lane 0 of each bundle,
+// written into each 768-byte bundle, it would be a miss a manifold on this one thread, a
+// serial part of a large solve on two threads), and the lane 0 of each bundle,
 // always taken, writes it into its bundle.
 template <class Place, class EmptiesSecond>
 void gather_on_threads(const Selection& m, BodyArrays& s, bool warm_start, const SweepSpace& space,
@@ -590,7 +589,7 @@ void scatter_bundles(const Selection& m, std::span<const SweepBundle> bundles, s
 // (the pool returns when a colour's blocks are all done: the next colour reads what they
 // wrote). Each block reduces its own maxima and |dP|^2, and the sweep adds the blocks' sums in
 // block order on any number of threads: the same sweep to the bit.
-constexpr std::size_t kBlock = 64;  // bundles: 256 manifolds, about 5 us of a sweep
+constexpr std::size_t kBlock = 64;  // bundles: 256 manifolds, many times the pool's hand-over
 // A colour goes to the pool only with this many blocks or more: the pool's join per colour and
 // sweep costs more than half of a colour of two or three blocks saves (the packed 4k field's
 // colours of about 100 bundles made its contact solve slower on two threads than on one).
@@ -645,7 +644,7 @@ SweepResult sweep_colours(std::span<SweepBundle> bundles, const Gathered& g, Bod
 // (P += beta p, p <- beta p + r) is taken by the next sweep as it reaches the bundle, before its
 // points' solves (take_step): the same order as a step made apart after the sweep. A step
 // made apart reads and writes every bundle once more each sweep, and its values twice: at 100k
-// floes, where the bundles come from memory, half as much traffic again as the sweep (perf).
+// floes, where the bundles come from memory, half as much traffic again as the sweep.
 // The velocities differ from a step made point by point only by rounding (a difference of
 // velocities instead of a sum of increments, some 1e-16 of a speed a sweep).
 

@@ -6,8 +6,7 @@
 // The sweeps in pair order update point after point, each reading the velocities the one before
 // it wrote. A pair list sorted by part puts a floe's contacts one after another, so each update
 // waits for the last one's stores, and the local solve's branches (separating, stick, slide
-// either way) are taken at random: about 14 ns a point on the packed 16k field, most of it
-// waiting. Greedy graph colouring of the manifolds (Box2D v3's constraint graph colouring;
+// either way) are taken at random: most of a point's time is waiting. Greedy graph colouring of the manifolds (Box2D v3's constraint graph colouring;
 // greedy colouring: Welsh and Powell 1967) gives each manifold the lowest colour that no other
 // manifold of either of its moving bodies took. Within a colour no two manifolds share a moving
 // body, so their updates commute: four of them (a bundle) are solved at once, lane by lane in
@@ -34,8 +33,8 @@
 namespace floedem {
 
 /// A coloured solve of at least this many manifolds is worth the pool's threads: its packing
-/// into bundles runs on them (on one thread it was a serial part of the packed 16k field's step
-/// that the threads could not shorten: perf), and the native engine solves such an island
+/// into bundles runs on them (on one thread it is a serial part of a packed field's step that
+/// the threads could not shorten), and the native engine solves such an island
 /// alone on every thread rather than as one task among the islands.
 constexpr std::size_t kColouredOnThreads = 4096;
 

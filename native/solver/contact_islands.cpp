@@ -16,8 +16,8 @@ std::int32_t ContactIslands::find(std::int32_t body) {
 
 namespace {
 // Manifolds ahead whose first line is asked for before it is read: the loop reads 8 bytes of
-// each 384-byte manifold, out of cache at 16k floes, and waited for each (perf: a third of the
-// build's samples on that load). A prefetch changes no value.
+// each 384-byte manifold, out of cache in a large field, and would wait for each. A prefetch
+// changes no value.
 constexpr std::size_t kManifoldsAhead = 8;
 }  // namespace
 
@@ -83,8 +83,8 @@ void ContactIslands::build(std::span<const Manifold> manifolds, const BodyArrays
     if (manifold_island_[k] >= 0) manifold_[fill_[manifold_island_[k]]++] = static_cast<std::int32_t>(k);
 
   // The bodies in contact, ascending: sorted where they are few (the towing case), read off
-  // the union-find in one pass where they are most of the scene (a packed field: the sort was
-  // 1 % of its step). The same list either way.
+  // the union-find in one pass where they are most of the scene (a packed field, where a sort
+  // of them all costs more than the pass). The same list either way.
   if (touched_.size() > nb / 16) {
     touched_.clear();
     for (std::size_t b = 0; b < nb; ++b)

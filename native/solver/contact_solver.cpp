@@ -109,8 +109,8 @@ void apply_accumulated_impulses(std::span<const Manifold> manifolds, BodyArrays&
 // follows (p_1 = r_1; beta > 1, the merit not falling, restarts with p = 0). Gauss-Seidel hands a
 // load on by one contact per sweep, so a pressed pack N floes deep needs of order N^2 sweeps;
 // the conjugate directions carry it across in of order N (a row of 50 pressed floes: 9.4 sweeps
-// a step against 21). It costs a pass over the moving points per sweep (the 4k field at 10
-// sweeps: +6 %), which the extra sweeps alone do not replace: a row of 50 floes at dt 0.01 s
+// a step against 21). It costs a pass over the moving points per sweep, which the extra
+// sweeps alone do not replace: a row of 50 floes at dt 0.01 s
 // creeps into its wall at 1.5 cm/s under 50 plain sweeps, each step's closing far below the
 // allowed overlap, and piles 10 mm of overlap. The sweep's local solve removes a point's own
 // impulse before solving it, so an iterate the step left outside the cone (P_n < 0 or

@@ -5,7 +5,8 @@
 //    impact into e = 0;
 //  - polygon radius 0: the default 0.01 m skin moves the contact point off the vertex and
 //    changes the friction lever arm (errors 6e-4 to 2e-3 against the exact answer);
-//  - no sleeping, no continuous collision (not needed at drift speeds, 17 % of the step);
+//  - no sleeping, no continuous collision (not needed at drift speeds, and a large part of
+//    the step's cost);
 //  - single precision: coordinates are taken relative to the scene's mean centroid.
 #include "reference/box2d/box2d_engine.hpp"
 

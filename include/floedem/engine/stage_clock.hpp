@@ -1,9 +1,8 @@
 #pragma once
 // Wall time per stage of a step, for `floedem bench` (where a step's time goes: the report's
 // speed section). Off unless asked for (Engine::time_stages, `floedem bench --stages`): then
-// each stage reads the clock twice, some 25 ns a stage on Linux's vDSO clock: nothing against a
-// field's milliseconds, but a two-floe impact's 0.1 us step takes 0.37 us with it, hence the
-// switch. The timing changes nothing the step computes.
+// each stage reads the clock twice: nothing against a field's step, but several times a
+// two-floe impact's whole step, hence the switch. The timing changes nothing the step computes.
 #include <array>
 #include <chrono>
 #include <cstddef>

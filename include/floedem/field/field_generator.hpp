@@ -54,7 +54,7 @@ struct FieldSpec {
   /// fraction 1 - sqrt(C) of each cell's radius) shrink below a few centimetres for metre-
   /// scale floes, and the field is a jam rather than broken ice.
   static constexpr double max_concentration = 0.99;
-  /// Most floes one field may hold (memory and time: about 1 KB and 0.1 ms each).
+  /// Most floes one field may hold (memory and time grow with each: about 1 KB a floe).
   static constexpr double max_floes = 2e7;
 };
 
