@@ -418,6 +418,23 @@ void Forcing::load_body(std::size_t i, const BodyStates& state, bool first_step)
   loads_.torque[i] = h.engine_inertia * dv[2] / dt_;
 }
 
+void Forcing::velocities_at_step_end(std::span<Vec2> v, std::span<double> w) const {
+  // v_n+1 ~ v(t_n+1 - dt/2) (the comment at the top), and ahead_ holds the step's mean
+  // acceleration a_n = (q_n+1 - q_n) / h, a(t_n) to first order: v(t_n+1) = v_n+1 + (dt/2) a_n
+  // + O(dt^2). A scene of Coriolis alone turns its velocities exactly: half the step's turn.
+  if (rotation_only_) {
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = turn_first_[i].apply(v[i]);
+    return;
+  }
+  if (!any_ahead_) return;
+  const double half = 0.5 * dt_;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::array<double, 3>& a = ahead_[i];
+    v[i] += half * Vec2{a[0], a[1]};
+    w[i] += half * a[2];
+  }
+}
+
 void Forcing::note_ahead() {
   any_ahead_ = std::any_of(ahead_.begin(), ahead_.end(), [](const std::array<double, 3>& a) {
     return a[0] != 0.0 || a[1] != 0.0 || a[2] != 0.0;

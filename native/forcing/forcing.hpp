@@ -39,6 +39,13 @@ class Forcing {
   /// every body is taken to be free (second order).
   const Loads* evaluate(const BodyStates& state, double time, std::span<const Rot> rotations = {},
                         std::span<const std::uint8_t> touching = {});
+  /// The velocities at the end of the last evaluated step, at the instant of the positions:
+  /// the engines' velocities sit half a step back (forcing.cpp), so each free body's gets the
+  /// half step of acceleration the forcing gave it over the step, (dt / 2) a, and in a scene of
+  /// Coriolis alone its turn over half a step. `v` and `w` hold the engine's velocities after
+  /// the step and are corrected in place. Second order in dt where the forcing's step is (free,
+  /// explicit bodies); a body in contact or under stiff drag keeps the engine's velocity.
+  void velocities_at_step_end(std::span<Vec2> v, std::span<double> w) const;
   /// Checkpoint: what the next step reads of the last (the accelerations of the free bodies).
   void save(StateWriter& out) const;
   void restore(StateReader& in);

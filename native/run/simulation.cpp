@@ -166,7 +166,7 @@ class SceneRun {
       summary_.max_kinetic_energy = summary_.kinetic_energy_start;
       constexpr double nan = std::numeric_limits<double>::quiet_NaN();
       if (tow_.active()) recorder_->write_tow(0.0, {{nan, nan}, {nan, nan}, {nan, nan}, tow_.tug_position(0.0)});  // no step yet
-      recorder_->write_frame(0.0, stepper_.state());
+      write_frame(0.0);
       return 1;
     }
     const std::vector<std::uint8_t>& bytes = *options_.resume_state;
@@ -224,7 +224,7 @@ class SceneRun {
       if (k % scene_.load_every() == 0) recorder.write_loads(t_end, loads_.take_row());
     }
     if (k % scene_.run.output_every == 0) {
-      recorder.write_frame(t_end, state);
+      write_frame(t_end);
       if (checkpoints_ && recorder.frames() % recorder.frame_chunk() == 0) checkpoint(k);
     }
   }
@@ -236,7 +236,7 @@ class SceneRun {
     const double t_end = stepper_.time();
     if (tow_.active() && steps_ % scene_.tow_every() != 0) recorder.write_tow(t_end, tow_.take_frame(t_end));
     if (loads_.active() && steps_ % scene_.load_every() != 0) recorder.write_loads(t_end, loads_.take_row());
-    if (steps_ % scene_.run.output_every != 0) recorder.write_frame(t_end, state);
+    if (steps_ % scene_.run.output_every != 0) write_frame(t_end);
     collisions_.finish(state, ended_);
     record_collisions();
     RunSummary& summary = summary_;
@@ -275,6 +275,11 @@ class SceneRun {
   }
 
  private:
+  void write_frame(double time) {
+    stepper_.frame_state(frame_);
+    recorder_->write_frame(time, frame_);
+  }
+
   void record_collisions() {
     for (const CollisionRow& r : ended_) summary_.max_peak_force = std::max(summary_.max_peak_force, r.peak_force);
     summary_.collision_events += static_cast<std::int64_t>(ended_.size());
@@ -320,6 +325,7 @@ class SceneRun {
   std::vector<CollisionRow> ended_;
   StateWriter checkpoint_bytes_;
   bool checkpoints_ = true;
+  BodyStates frame_;  // the state a frame records (Stepper::frame_state)
 };
 
 }  // namespace

@@ -51,6 +51,15 @@ Stepper::Stepper(const Scene& scene, const std::string& engine)
   if (!forcing_.empty()) touching_ = touching_at_start(scene);
 }
 
+void Stepper::frame_state(BodyStates& out) const {
+  const BodyStates& s = engine_->state();
+  out.position.assign(s.position.begin(), s.position.end());
+  out.angle.assign(s.angle.begin(), s.angle.end());
+  out.velocity.assign(s.velocity.begin(), s.velocity.end());
+  out.angular_velocity.assign(s.angular_velocity.begin(), s.angular_velocity.end());
+  if (steps_ > 0 && !forcing_.empty()) forcing_.velocities_at_step_end(out.velocity, out.angular_velocity);
+}
+
 void Stepper::step() {
   const double start = time();
   if (tow_.active()) stages_.time(kTowing, [&] { tow_.before_step(engine_->state(), start); });

@@ -29,6 +29,10 @@ class Stepper {
   double time() const { return static_cast<double>(steps_) * dt_; }
   const Engine& engine() const { return *engine_; }
   const BodyStates& state() const { return engine_->state(); }
+  /// The state as a frame records it: the engine's positions and angles after the steps done,
+  /// with the velocities at that instant (Forcing::velocities_at_step_end; at t = 0 the
+  /// scene's own). One copy of the state.
+  void frame_state(BodyStates& out) const;
   std::span<const ContactRecord> contacts() const { return engine_->contacts(); }
   const Forcing& forcing() const { return forcing_; }
   /// The loads of the last step (nullptr: none), valid until the next step.

@@ -11,6 +11,7 @@
 
 #include "floedem/version.hpp"
 #include "io/recorder.hpp"
+#include "run/stepper.hpp"
 #include "floedem/run/simulation.hpp"
 #include "floedem/scene/input_error.hpp"
 #include "support.hpp"
@@ -263,5 +264,36 @@ TEST_CASE("a run's output of another format_version is refused, naming the file 
                    ") reads " + std::to_string(kOutputFormatVersion)) != std::string::npos);
       CHECK(m.find("a newer floedem wrote it") != std::string::npos);
     }
+  }
+}
+
+TEST_CASE("a frame records the velocities at the instant of its positions", "[output]") {
+  // free_drift_analytic.toml (a floe in a current with Coriolis) for an hour, a frame every 10
+  // steps: each frame's velocity is the Stepper's frame_state at that step, to the bit, which
+  // differs from the engine's own half-step velocity by (dt / 2) a (test_environment.cpp holds
+  // both against the closed form).
+  const fs::path dir = test::temp_dir("frame_velocity");
+  const std::string out = (dir / "r.h5").string();
+  const Scene s = load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/free_drift_analytic.toml",
+                                {"run.duration=3600", "run.output_every=10"});
+  RunOptions o;
+  o.output = out;
+  o.progress = false;
+  run_scene(s, o);
+  H5::H5File f(out, H5F_ACC_RDONLY);
+  std::vector<double> v(2 * 7);
+  f.openDataSet("/bodies/velocity").read(v.data(), H5::PredType::NATIVE_DOUBLE);
+  Stepper run(s, "native");
+  BodyStates frame;
+  run.frame_state(frame);
+  CHECK(v[0] == frame.velocity[0].x);  // t = 0: the scene's own
+  for (int k = 1; k <= 60; ++k) {
+    run.step();
+    if (k % 10 != 0) continue;
+    run.frame_state(frame);
+    INFO("step " << k);
+    CHECK(v[2 * static_cast<std::size_t>(k / 10)] == frame.velocity[0].x);
+    CHECK(v[2 * static_cast<std::size_t>(k / 10) + 1] == frame.velocity[0].y);
+    CHECK(frame.velocity[0].x != run.state().velocity[0].x);
   }
 }
