@@ -14,7 +14,10 @@ const char* version();
 /// (runs and fields). It rises by one whenever a change would make a reader of the last layout
 /// misread a file: a dataset or attribute removed or renamed, or its unit, shape, type or meaning
 /// changed. Adding a dataset or an attribute leaves it as it is (readers ignore what they do not
-/// know). floedem's readers (io/output.hpp) refuse a file of another version, naming both.
-inline constexpr std::int64_t kOutputFormatVersion = 1;
+/// know). floedem's readers (io/output.hpp) read every version from kOldestOutputFormatVersion
+/// on and refuse another, naming both. Version 2: every string fixed-length (version 1's were
+/// variable-length, stored on HDF5's global heap).
+inline constexpr std::int64_t kOutputFormatVersion = 2;
+inline constexpr std::int64_t kOldestOutputFormatVersion = 1;
 
 }  // namespace floedem

@@ -1,5 +1,6 @@
 #include "io/h5_read.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "floedem/scene/input_error.hpp"
@@ -10,6 +11,18 @@ namespace floedem {
 std::vector<std::string> read_strings(H5::H5File& f, const std::string& name) {
   H5::DataSet ds = f.openDataSet(name);
   const auto n = static_cast<std::size_t>(ds.getSpace().getSimpleExtentNpoints());
+  if (!ds.getStrType().isVariableStr()) {
+    // Fixed-length: n slots of `size` bytes each, a name NUL-padded (or NUL-terminated) in its slot.
+    const std::size_t size = ds.getStrType().getSize();
+    std::vector<char> raw(n * size);
+    if (n > 0) ds.read(raw.data(), ds.getStrType());
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < n; ++i) {
+      const char* s = raw.data() + i * size;
+      out.emplace_back(s, std::find(s, s + size, '\0'));
+    }
+    return out;
+  }
   H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
   type.setCset(H5T_CSET_UTF8);
   std::vector<char*> raw(n, nullptr);
@@ -80,22 +93,42 @@ H5::Attribute CheckedFile::scalar_attribute(const std::string& object, const std
   return a;
 }
 
-void CheckedFile::check_format_version() const {
+std::int64_t CheckedFile::check_format_version() const {
   if (!H5::Group(file_.openGroup("/")).attrExists("format_version"))
     fail("/@format_version", "missing: not written by floedem, or by a floedem older than the format's first version; this floedem reads format " +
                                  std::to_string(kOutputFormatVersion));
   const std::int64_t format = integer_attribute("/", "format_version");
-  if (format != kOutputFormatVersion)
+  if (format < kOldestOutputFormatVersion || format > kOutputFormatVersion)
     fail("/@format_version", "is " + std::to_string(format) + ", this floedem (" + version() + ") reads " +
                                  std::to_string(kOutputFormatVersion) +
                                  (format > kOutputFormatVersion ? ": a newer floedem wrote it" : ": an older floedem wrote it"));
+  format_ = format;
+  return format;
+}
+
+std::int64_t CheckedFile::string_format() const {
+  if (format_ != 0) return format_;
+  H5::Group root = file_.openGroup("/");
+  if (root.attrExists("format_version")) {
+    H5::Attribute a = root.openAttribute("format_version");
+    std::int64_t v = 0;
+    if (a.getTypeClass() == H5T_INTEGER && a.getSpace().getSimpleExtentNpoints() == 1) {
+      a.read(H5::PredType::NATIVE_INT64, &v);
+      if (v == 1) return 1;
+    }
+  }
+  return kOutputFormatVersion;
 }
 
 std::string CheckedFile::text_attribute(const std::string& name, bool required) const {
   if (!required && !H5::Group(file_.openGroup("/")).attrExists(name)) return {};
   H5::Attribute a = scalar_attribute("/", name, H5T_STRING);
+  const H5::StrType type = a.getStrType();
+  if (fixed_strings() && type.isVariableStr())
+    fail("/@" + name, "holds a variable-length string; format " + std::to_string(string_format()) +
+                          " stores fixed-length ones: damaged, or not written by floedem");
   std::string v;
-  a.read(a.getStrType(), v);
+  a.read(type, v);
   return v;
 }
 
@@ -202,7 +235,9 @@ std::vector<std::uint8_t> CheckedFile::bytes(const std::string& name, const std:
 std::vector<std::string> CheckedFile::strings(const std::string& name, std::int64_t n) const {
   std::vector<hsize_t> dims;
   H5::DataSet ds = dataset(name, H5T_STRING, {n}, dims);
-  if (!ds.getStrType().isVariableStr()) fail(name, "expected variable-length strings");
+  if (ds.getStrType().isVariableStr() == fixed_strings())
+    fail(name, fixed_strings() ? "holds variable-length strings; expected fixed-length ones (format 2)"
+                               : "holds fixed-length strings; expected variable-length ones (format 1)");
   return read_strings(file_, name);
 }
 

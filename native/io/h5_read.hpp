@@ -25,8 +25,8 @@ std::vector<T> read_all(H5::H5File& f, const std::string& name, const H5::DataTy
   return out;
 }
 
-/// Every string of a 1-D dataset of variable-length UTF-8 strings (as the recorder writes
-/// /bodies/name).
+/// Every string of a 1-D dataset of UTF-8 strings, fixed-length (format 2, as the recorder
+/// writes /bodies/name) or variable-length (format 1).
 std::vector<std::string> read_strings(H5::H5File& f, const std::string& name);
 
 /// A file given by the user, read with every check. Each failure throws InputError
@@ -39,9 +39,11 @@ class CheckedFile {
   /// True when the object (a group or dataset, absolute path) exists, its parents too.
   bool exists(const std::string& path) const;
 
-  /// The root attribute format_version, which must be this floedem's kOutputFormatVersion.
-  void check_format_version() const;
-  /// A scalar string attribute of the root; empty when absent and !required.
+  /// The root attribute format_version, which must be one this floedem reads
+  /// (kOldestOutputFormatVersion to kOutputFormatVersion); returns it.
+  std::int64_t check_format_version() const;
+  /// A scalar string attribute of the root; empty when absent and !required. Of format 2 on,
+  /// a variable-length one is refused unread (it would be read from the global heap).
   std::string text_attribute(const std::string& name, bool required) const;
   /// A scalar numeric attribute of `object` (a group or dataset path).
   double real_attribute(const std::string& object, const std::string& name) const;
@@ -69,6 +71,11 @@ class CheckedFile {
   H5::Attribute scalar_attribute(const std::string& object, const std::string& name, H5T_class_t type_class) const;
   H5::H5File& file_;
   std::string label_;
+  mutable std::int64_t format_ = 0;  // check_format_version's (0: not checked yet)
+  // The file's format as far as its strings go: check_format_version's, else the root's
+  // format_version where it is one integer, else this floedem's.
+  std::int64_t string_format() const;
+  bool fixed_strings() const { return string_format() >= 2; }
 };
 
 }  // namespace floedem

@@ -106,10 +106,29 @@ void write_fixed(H5::Group& g, const std::string& name, const H5::DataType& type
   if (!data.empty()) ds.write(data.data(), type);
 }
 
-void write_attribute(H5::H5Object& obj, const std::string& name, const std::string& value) {
-  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+// A string as format 2 stores it: fixed-length, its own length (at least one byte), padded with
+// NULs, so that no reader goes through HDF5's global heap, whose damaged objects Debian's HDF5
+// reads out of bounds. Format 1 (a run written before, continued by --resume) keeps
+// variable-length strings, as its readers expect.
+H5::StrType string_type(std::size_t longest, bool fixed) {
+  H5::StrType type(H5::PredType::C_S1, fixed ? std::max<std::size_t>(1, longest) : H5T_VARIABLE);
+  if (fixed) type.setStrpad(H5T_STR_NULLPAD);
   type.setCset(H5T_CSET_UTF8);
-  H5::Attribute a = obj.attrExists(name) ? obj.openAttribute(name) : obj.createAttribute(name, type, H5::DataSpace(H5S_SCALAR));
+  return type;
+}
+
+void write_text(H5::H5Object& obj, const std::string& name, const std::string& value, bool fixed) {
+  const H5::StrType type = string_type(value.size(), fixed);
+  if (obj.attrExists(name)) {
+    H5::Attribute old = obj.openAttribute(name);
+    if (old.getDataType() == type) {
+      old.write(type, value);
+      return;
+    }
+    old.close();
+    obj.removeAttr(name);  // another length: made again
+  }
+  H5::Attribute a = obj.createAttribute(name, type, H5::DataSpace(H5S_SCALAR));
   a.write(type, value);
 }
 
@@ -153,6 +172,9 @@ std::uint64_t slot_checksum(std::int64_t step, const std::vector<std::uint8_t>& 
 
 struct Recorder::Impl {
   H5::H5File file;
+  // The file's layout: this floedem's, or a format 1 run's that --resume continues as it is.
+  std::int64_t format = kOutputFormatVersion;
+  bool fixed_strings = true;  // format 2 on: every string fixed-length (string_type)
   std::size_t bodies = 0;
   // Frames.
   Series time, position, angle, velocity, angular_velocity;
@@ -321,24 +343,25 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     Impl& d = *impl_;
     d.file = H5::H5File(partial_path_, H5F_ACC_TRUNC);
     H5::Group root = d.file.openGroup("/");
-    write_attribute(root, "status", "running");
-    write_attribute(root, "engine", engine.name);
-    write_attribute(root, "engine_version", engine.version);
+    write_text(root, "status", "running", d.fixed_strings);
+    write_text(root, "engine", engine.name, d.fixed_strings);
+    write_text(root, "engine_version", engine.version, d.fixed_strings);
     write_run_attributes(scene, run);
 
     H5::Group eng = d.file.createGroup("/engine");
-    for (const auto& [k, v] : engine.settings) write_attribute(eng, k, v);
-    write_attribute(eng, "limitations", join(engine.limitations, "\n"));
+    for (const auto& [k, v] : engine.settings) write_text(eng, k, v, d.fixed_strings);
+    write_text(eng, "limitations", join(engine.limitations, "\n"), d.fixed_strings);
 
     // Bodies: what does not change.
     const std::size_t n = scene.bodies.size();
     d.bodies = n;
     H5::Group bodies = d.file.createGroup("/bodies");
     {
-      std::vector<const char*> names;
-      for (const auto& b : scene.bodies) names.push_back(b.name.c_str());
-      H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-      type.setCset(H5T_CSET_UTF8);
+      std::size_t longest = 0;
+      for (const auto& b : scene.bodies) longest = std::max(longest, b.name.size());
+      const H5::StrType type = string_type(longest, true);
+      std::vector<char> names(n * type.getSize(), '\0');  // each name in its slot, NUL-padded
+      for (std::size_t i = 0; i < n; ++i) std::copy(scene.bodies[i].name.begin(), scene.bodies[i].name.end(), &names[i * type.getSize()]);
       write_fixed(bodies, "name", type, names, {n});
     }
     std::vector<double> mass, inertia, area, thickness, density;
@@ -370,16 +393,16 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     H5::Group contacts = d.file.createGroup("/contacts");
     const char* which = scene.output.contacts == ContactOutput::all ? "all"
                         : scene.output.contacts == ContactOutput::collisions ? "collisions" : "none";
-    write_attribute(contacts, "recorded", which);
+    write_text(contacts, "recorded", which, d.fixed_strings);
     d.contact_output = scene.output.contacts;
     H5::Group events = d.file.createGroup("/contacts/collisions");
     write_attribute(events, "duration_coefficient", scene.contact.duration_coefficient);
-    write_attribute(events, "duration_model", describe(duration_model_of(engine)));
+    write_text(events, "duration_model", describe(duration_model_of(engine)), d.fixed_strings);
     if (scene.tow.mode != TowSpec::Mode::none) {
       d.tow = true;
       H5::Group tow = d.file.createGroup("/tow");
-      write_attribute(tow, "mode", scene.tow.mode == TowSpec::Mode::velocity ? "velocity" : "rope");
-      write_attribute(tow, "body", scene.bodies[scene.tow.body].name);
+      write_text(tow, "mode", scene.tow.mode == TowSpec::Mode::velocity ? "velocity" : "rope", d.fixed_strings);
+      write_text(tow, "body", scene.bodies[scene.tow.body].name, d.fixed_strings);
     }
     if (!scene.output.load_bodies.empty()) {
       H5::Group loads = d.file.createGroup("/loads");
@@ -391,7 +414,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     for (const Impl::Table& t : d.tables(scene)) *t.series = Series(root, t.path, t.type, t.row_shape, t.chunk);
     for (const Provenance& p : scene.provenance) {
       H5::Group g = d.file.createGroup(p.group);
-      for (const auto& [k, v] : p.text) write_attribute(g, k, v);
+      for (const auto& [k, v] : p.text) write_text(g, k, v, d.fixed_strings);
       for (const auto& [k, v] : p.numbers) write_attribute(g, k, v);
     }
     d.flush();
@@ -405,22 +428,25 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
 
 void Recorder::write_run_attributes(const Scene& scene, const RunInfo& run) {
   H5::Group root = impl_->file.openGroup("/");
-  write_number_attribute(root, "format_version", H5::PredType::NATIVE_INT64, kOutputFormatVersion);
-  write_attribute(root, "floedem_version", run.floedem_version);
-  write_attribute(root, "scenario", scene.source_text);
-  write_attribute(root, "scenario_path", scene.source_path);
-  write_attribute(root, "overrides", join(scene.overrides, "\n"));
+  const bool fixed = impl_->fixed_strings;
+  write_number_attribute(root, "format_version", H5::PredType::NATIVE_INT64, impl_->format);
+  write_text(root, "floedem_version", run.floedem_version, fixed);
+  write_text(root, "scenario", scene.source_text, fixed);
+  write_text(root, "scenario_path", scene.source_path, fixed);
+  write_text(root, "overrides", join(scene.overrides, "\n"), fixed);
   write_attribute(root, "dt", scene.run.dt);
   write_attribute(root, "duration", scene.run.duration);
   write_attribute(root, "output_every", static_cast<double>(scene.run.output_every));
-  write_attribute(root, "forcing_terms", join(run.forcing_terms, ", "));
+  write_text(root, "forcing_terms", join(run.forcing_terms, ", "), fixed);
 }
 
 Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& run, const RecordedRows& rows)
     : impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
   namespace fs = std::filesystem;
   H5::Exception::dontPrint();
-  check_tables(fs::exists(partial_path_) ? partial_path_ : path_, scene, rows);
+  const std::int64_t format = check_tables(fs::exists(partial_path_) ? partial_path_ : path_, scene, rows);
+  impl_->format = format;
+  impl_->fixed_strings = format >= 2;
   // A finished run being continued is no longer complete: it goes back under .partial first.
   if (!fs::exists(partial_path_)) {
     std::error_code ec;
@@ -432,7 +458,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& r
   try {
     d.file = H5::H5File(partial_path_, H5F_ACC_RDWR);
     H5::Group root = d.file.openGroup("/");
-    write_attribute(root, "status", "running");
+    write_text(root, "status", "running", d.fixed_strings);
     std::vector<std::string> summary;
     for (int k = 0; k < root.getNumAttrs(); ++k) {
       const std::string name = root.openAttribute(static_cast<unsigned>(k)).getName();
@@ -489,11 +515,12 @@ RecordedRows Recorder::rows() const {
 
 std::int64_t Recorder::frame_chunk() const { return static_cast<std::int64_t>(impl_->frame_chunk); }
 
-void Recorder::check_tables(const std::string& file, const Scene& scene, const RecordedRows& rows) const {
+std::int64_t Recorder::check_tables(const std::string& file, const Scene& scene, const RecordedRows& rows) const {
   H5::Exception::dontPrint();
   try {
     H5::H5File f(file, H5F_ACC_RDONLY);
     const CheckedFile checked(f, file);
+    const std::int64_t format = checked.check_format_version();
     Impl layout;
     layout.bodies = scene.bodies.size();
     layout.frame_chunk = frame_chunk_of(layout.bodies);
@@ -508,6 +535,7 @@ void Recorder::check_tables(const std::string& file, const Scene& scene, const R
         checked.fail(t.path, "has " + std::to_string(dims[0]) + " rows; its checkpoint counts " +
                                  std::to_string(rows.*t.rows) + ": damaged");
     }
+    return format;
   } catch (const H5::Exception& e) {
     throw InputError(file + ": cannot read it (" + e.getDetailMsg() + "); damaged, or not a floedem file?");
   }
@@ -638,7 +666,7 @@ std::int64_t Recorder::contact_rows() const {
 void Recorder::update_engine_info(const EngineInfo& engine) {
   try {
     H5::Group eng = impl_->file.openGroup("/engine");
-    for (const auto& [k, v] : engine.settings) write_attribute(eng, k, v);
+    for (const auto& [k, v] : engine.settings) write_text(eng, k, v, impl_->fixed_strings);
   } catch (const H5::Exception& e) {
     throw OutputError(partial_path_ + ": could not update /engine (" + e.getDetailMsg() + ")");
   }
@@ -675,7 +703,7 @@ void Recorder::finish(const std::vector<std::pair<std::string, double>>& summary
   try {
     H5::Group root = d.file.openGroup("/");
     for (const auto& [k, v] : summary) write_attribute(root, "summary_" + k, v);
-    write_attribute(root, "status", "complete");
+    write_text(root, "status", "complete", impl_->fixed_strings);
     d.flush();
     d.file.close();
     d.closed = true;

@@ -86,7 +86,8 @@ class Recorder {
   void check_space(const Scene& scene) const;
   /// InputError, before anything is changed, when a run's file to continue lacks a table of
   /// the scene's layout, or has one of another type or shape, or fewer rows than `rows`.
-  void check_tables(const std::string& file, const Scene& scene, const RecordedRows& rows) const;
+  /// Returns the file's format_version (a format 1 run is continued in format 1).
+  std::int64_t check_tables(const std::string& file, const Scene& scene, const RecordedRows& rows) const;
   void write_run_attributes(const Scene& scene, const RunInfo& run);
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -6,9 +6,11 @@ import numpy as np
 
 from .errors import FileError  # noqa: F401  (raised here; floedem.FileError)
 
-#: The output layout this package reads: the root attribute `format_version` of floedem's files
-#: (docs/output.md; the C++ library's kOutputFormatVersion).
-FORMAT_VERSION = 1
+#: The output layout this package writes and reads: the root attribute `format_version` of
+#: floedem's files (docs/output.md; the C++ library's kOutputFormatVersion). Version 2 stores
+#: every string fixed-length; version 1 files (variable-length strings) are read as well.
+FORMAT_VERSION = 2
+OLDEST_FORMAT_VERSION = 1
 
 
 # Each table: its datasets and their shapes after the row count ("N": bodies, "B": load bodies).
@@ -114,7 +116,8 @@ class Run:
             raise self._error("/@format_version", "missing: not written by floedem, or by one older than the "
                                                   f"format's first version; this package reads {FORMAT_VERSION}")
         self.format_version = self.attrs["format_version"]
-        if self.format_version != FORMAT_VERSION:
+        if not isinstance(self.format_version, int) or not \
+                OLDEST_FORMAT_VERSION <= self.format_version <= FORMAT_VERSION:
             newer = isinstance(self.format_version, int) and self.format_version > FORMAT_VERSION
             raise self._error("/@format_version", f"is {self.format_version}, this package reads {FORMAT_VERSION}: "
                                                   f"{'a newer' if newer else 'an older'} floedem wrote it")

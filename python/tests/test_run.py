@@ -1,5 +1,6 @@
 """floedem.open: the layout as numpy arrays, and every bad file refused with the file and the
 dataset named."""
+import os
 import shutil
 
 import h5py
@@ -11,7 +12,7 @@ import floedem
 
 def test_a_run_as_arrays(runs):
     with floedem.open(runs / "scene.h5") as r:
-        assert r.format_version == floedem.FORMAT_VERSION == 1
+        assert r.format_version == floedem.FORMAT_VERSION == 2
         assert r.status == "complete" and r.engine == "native"
         assert list(r.bodies.name) == ["wall", "berg", "a", "b"]
         n, t = 4, len(r.time)
@@ -66,8 +67,8 @@ def damaged(runs, tmp_path, edit):
 
 
 @pytest.mark.parametrize("what, edit, needle", [
-    ("newer format", lambda f: f.attrs.__setitem__("format_version", np.int64(2)),
-     "/@format_version: is 2, this package reads 1: a newer floedem wrote it"),
+    ("newer format", lambda f: f.attrs.__setitem__("format_version", np.int64(3)),
+     "/@format_version: is 3, this package reads 2: a newer floedem wrote it"),
     ("no format", lambda f: f.attrs.__delitem__("format_version"), "/@format_version: missing"),
     ("no bodies", lambda f: f.__delitem__("bodies"), "/bodies: missing"),
     ("offsets not from 0", lambda f: f["bodies/polygon_offsets"].__setitem__(0, 1), "/bodies/polygon_offsets"),
@@ -98,3 +99,17 @@ def test_frame_out_of_range(runs):
         with pytest.raises(floedem.FileError, match=r"frame 500 is out of range; the file has 201 frames"):
             r.polygons(500)
         assert len(r.polygons(-201)) == 2
+
+
+def test_a_format_1_file_is_read(tmp_path):
+    # A run written by a floedem of format 1 (variable-length strings), kept in the repository:
+    # read as a format 2 one is, its strings the same.
+    import gzip
+    from conftest import ROOT
+    path = tmp_path / "run.h5"
+    with gzip.open(os.path.join(ROOT, "tests", "io", "format1", "run.h5.gz")) as src, open(path, "wb") as dst:
+        shutil.copyfileobj(src, dst)
+    with floedem.open(path) as r:
+        assert r.format_version == 1 and r.status == "complete" and r.engine == "native"
+        assert all(isinstance(n, str) and n for n in r.bodies.name)
+        assert "[run]" in r.attrs["scenario"]

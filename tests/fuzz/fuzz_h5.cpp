@@ -3,21 +3,30 @@
 // through HDF5's file-image API (the core driver, no disk). Bad input must end in InputError;
 // anything else escaping, a crash, a hang or a sanitizer report is a bug.
 //
-// The mutator is structure-aware: it opens the image with HDF5 and edits it through HDF5 (a
-// value made NaN, infinite, negative, zero or huge; a dataset or attribute removed, or remade
-// with another type or shape; a string changed), then hands back the image HDF5 writes. Byte
-// mutations would test HDF5's own parser instead of floedem's checks, and Debian's HDF5 1.10
-// does not survive them (a damaged global-heap object size makes H5HG_read copy out of bounds
-// within seconds): floedem cannot guard against that, short of not using HDF5. The seeds
-// (tests/fuzz/corpus/h5, made by make_h5_corpus.sh) are real outputs and damaged ones.
+// The mutator takes one of two kinds of edit. Half the time it mutates the bytes of the
+// datasets as stored in the image, contiguous or chunked (libFuzzer's own byte mutations,
+// within each dataset's stored extent): numbers and strings as any damage leaves them, read by
+// floedem's checks. These are bytes HDF5 hands back as data without parsing them: format 2's
+// strings are fixed-length, stored in the dataset itself; format 1's were references into
+// HDF5's global heap, and Debian's HDF5 1.10 reads a damaged global-heap object out of bounds
+// within seconds. HDF5's own metadata (object headers, B-trees) is left to the other half:
+// mutated byte by byte, Debian's HDF5 1.10.8 overflows a heap buffer decoding a damaged
+// datatype message (H5T_copy under H5O_msg_read) within a few thousand inputs, a crash in HDF5
+// that no reader can guard against. The other half is structure-aware: it opens the image with
+// HDF5 and edits it through HDF5 (a value made NaN, infinite, negative, zero or huge; a dataset
+// or attribute removed, or remade with another type or shape; a string changed), then hands
+// back the image HDF5 writes. The seeds (tests/fuzz/corpus/h5, made by make_h5_corpus.sh) are
+// real format 2 outputs and damaged ones.
 #include <H5Cpp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "floedem/scene/input_error.hpp"
@@ -113,11 +122,15 @@ void reattribute(hid_t file, const char* object, const char* name, std::mt19937_
     if (kind == 3) {
       const char* texts[] = {"complete", "running", "", "native", "[run]\nduration = 1\ndt = 0.1\n", "x"};
       const char* text = texts[rng() % std::size(texts)];
+      // Fixed-length, as format 2 writes them (a scalar of the text's length; an array of three).
       const hid_t type = H5Tcopy(H5T_C_S1);
-      H5Tset_size(type, H5T_VARIABLE);
+      H5Tset_size(type, std::max<std::size_t>(1, std::strlen(text)));
+      H5Tset_strpad(type, H5T_STR_NULLPAD);
       const hid_t a = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
       if (a >= 0) {
-        H5Awrite(a, type, &text);
+        std::string values(3 * H5Tget_size(type), '\0');
+        for (std::size_t k = 0; k < 3; ++k) std::memcpy(&values[k * H5Tget_size(type)], text, std::strlen(text));
+        H5Awrite(a, type, values.data());
         H5Aclose(a);
       }
       H5Tclose(type);
@@ -137,9 +150,61 @@ void reattribute(hid_t file, const char* object, const char* name, std::mt19937_
 
 }  // namespace
 
+extern "C" std::size_t LLVMFuzzerMutate(std::uint8_t* data, std::size_t size, std::size_t max_size);
+
+namespace {
+
+/// The byte ranges of the image that hold datasets' stored values: each contiguous dataset's
+/// extent and each chunk of a chunked one, of the datasets the readers look at.
+std::vector<std::pair<std::size_t, std::size_t>> stored_extents(hid_t file, std::size_t size) {
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  auto keep = [&](haddr_t at, hsize_t n) {
+    if (at != HADDR_UNDEF && n > 0 && at < size && n <= size - at)
+      out.emplace_back(static_cast<std::size_t>(at), static_cast<std::size_t>(n));
+  };
+  for (const char* path : kDatasets) {
+    if (!exists(file, path)) continue;
+    const hid_t set = H5Dopen2(file, path, H5P_DEFAULT);
+    if (set < 0) continue;
+    const hid_t plist = H5Dget_create_plist(set);
+    if (plist >= 0 && H5Pget_layout(plist) == H5D_CHUNKED) {
+      const hid_t space = H5Dget_space(set);
+      hsize_t chunks = 0;
+      if (H5Dget_num_chunks(set, space, &chunks) >= 0)
+        for (hsize_t c = 0; c < chunks && c < 64; ++c) {
+          haddr_t at = HADDR_UNDEF;
+          hsize_t n = 0;
+          unsigned mask = 0;
+          if (H5Dget_chunk_info(set, space, c, nullptr, &mask, &at, &n) >= 0) keep(at, n);
+        }
+      H5Sclose(space);
+    } else {
+      keep(H5Dget_offset(set), H5Dget_storage_size(set));
+    }
+    if (plist >= 0) H5Pclose(plist);
+    H5Dclose(set);
+  }
+  return out;
+}
+
+}  // namespace
+
 extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t size, std::size_t max_size,
                                                unsigned int seed) {
   std::mt19937_64 rng(seed);
+  if (rng() % 2 == 0) {
+    const hid_t file = open_image(data, size, H5F_ACC_RDONLY);
+    if (file < 0) return size;
+    const auto extents = stored_extents(file, size);
+    H5Fclose(file);
+    if (extents.empty()) return size;
+    // One dataset's stored bytes, mutated in place at their size (the image keeps its layout).
+    const auto [at, n] = extents[rng() % extents.size()];
+    std::vector<std::uint8_t> bytes(data + at, data + at + n);
+    const std::size_t changed = LLVMFuzzerMutate(bytes.data(), n, n);
+    std::copy(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(std::min(changed, n)), data + at);
+    return size;
+  }
   const hid_t file = open_image(data, size, H5F_ACC_RDWR);
   if (file < 0) return size;
   const int edits = 1 + static_cast<int>(rng() % 3);

@@ -12,6 +12,8 @@
 #include "floedem/version.hpp"
 #include "io/recorder.hpp"
 #include "run/stepper.hpp"
+#include "floedem/io/output.hpp"
+#include "floedem/run/resume.hpp"
 #include "floedem/run/simulation.hpp"
 #include "floedem/scene/input_error.hpp"
 #include "support.hpp"
@@ -296,4 +298,67 @@ TEST_CASE("a frame records the velocities at the instant of its positions", "[ou
     CHECK(v[2 * static_cast<std::size_t>(k / 10) + 1] == frame.velocity[0].y);
     CHECK(frame.velocity[0].x != run.state().velocity[0].x);
   }
+}
+
+TEST_CASE("format 1 files, with variable-length strings, are read and continued in format 1", "[output][resume]") {
+  // Files written by a floedem of format 1, kept in the repository (tests/io/format1): a field,
+  // a complete run and a run with checkpoints. Each is read as before; the last is continued
+  // by --resume to a longer duration and stays a format 1 file (its strings variable-length).
+  const fs::path dir = test::temp_dir("format1");
+  auto unpack = [&](const std::string& name) {
+    const std::string out = (dir / name).string();
+    const std::string command = "gunzip -c '" + std::string(FLOEDEM_SOURCE_DIR) + "/tests/io/format1/" + name +
+                                ".gz' > '" + out + "'";
+    REQUIRE(std::system(command.c_str()) == 0);
+    return out;
+  };
+  const BodyFrame field = read_body_frame(unpack("field.h5"));
+  CHECK(field.names.size() == field.polygons.size());
+  CHECK_FALSE(field.names.front().empty());
+  const StoredRun run = read_stored_run(unpack("run.h5"));
+  CHECK(run.status == "complete");
+  CHECK(run.engine == "native");
+  CHECK(run.scenario.find("[run]") != std::string::npos);
+  const std::string checkpointed = unpack("checkpoint.h5");
+  const StoredRun before = read_stored_run(checkpointed);
+  const ResumeResult r = resume_run(checkpointed, {"run.duration=" + std::to_string(before.duration + 10.0)}, false);
+  CHECK(r.ran);
+  H5::H5File f(checkpointed, H5F_ACC_RDONLY);
+  std::int64_t format = 0;
+  f.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
+  CHECK(format == 1);
+  CHECK(f.openAttribute("status").getStrType().isVariableStr());
+  CHECK(f.openDataSet("/bodies/name").getStrType().isVariableStr());
+  const StoredRun after = read_stored_run(checkpointed);
+  CHECK(after.status == "complete");
+  CHECK(after.duration == Approx(before.duration + 10.0));
+}
+
+TEST_CASE("format 2 stores every string fixed-length", "[output]") {
+  const fs::path dir = test::temp_dir("format2");
+  const std::string out = (dir / "r.h5").string();
+  RunOptions o;
+  o.output = out;
+  run_scene(test::scene_from(kScene), o);
+  H5::H5File f(out, H5F_ACC_RDONLY);
+  std::int64_t format = 0;
+  f.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
+  CHECK(format == 2);
+  auto fixed = [](const H5::StrType& t) { return !t.isVariableStr(); };
+  H5::Group root = f.openGroup("/");
+  for (int k = 0; k < root.getNumAttrs(); ++k) {
+    const H5::Attribute a = root.openAttribute(static_cast<unsigned>(k));
+    INFO(a.getName());
+    if (a.getTypeClass() == H5T_STRING) CHECK(fixed(a.getStrType()));
+  }
+  H5::Group engine = f.openGroup("/engine");
+  for (int k = 0; k < engine.getNumAttrs(); ++k) {
+    const H5::Attribute a = engine.openAttribute(static_cast<unsigned>(k));
+    INFO(a.getName());
+    if (a.getTypeClass() == H5T_STRING) CHECK(fixed(a.getStrType()));
+  }
+  CHECK(fixed(f.openDataSet("/bodies/name").getStrType()));
+  CHECK(string_attribute(root, "status") == "complete");
+  CHECK(read_stored_run(out).status == "complete");
+  CHECK(read_body_frame(out).names == std::vector<std::string>{"a", "b"});
 }
