@@ -3,7 +3,8 @@ does not hold in the form a reader needs (each frame's world-frame vertices, the
 XDMF cells, velocities as 3-vectors, the collision points). The run's file is read only: the
 XDMF refers to it, by its path relative to the XDMF, for the datasets it holds as they are.
 
-In ParaView: File > Open RUN.xdmf, reader "XDMF Reader". Block "bodies" holds the polygons over
+In ParaView: File > Open RUN.xdmf with any of its three XDMF readers (the Xdmf3 ones give the
+first block alone; docs/python.md). Block "bodies" holds the polygons over
 time, with cell data velocity, angular_velocity, mass, thickness, density and fixed; block
 "collisions" holds every collision event as a point (between the bodies, at the impulse-weighted
 contact point when the run recorded its contacts, else midway between the two centroids at the
@@ -89,16 +90,19 @@ def export(run_path, out=None):
         points, columns = _collision_points(run)
         tmp_side = side_path + ".partial"
         with h5py.File(tmp_side, "w") as s:
-            s.attrs["source"] = os.path.basename(run_path)
+            # Fixed-length, as floedem's own files store strings (format 2: no global heap).
+            s.attrs["source"] = np.bytes_(os.path.basename(run_path).encode())
             s.attrs["format_version"] = run.format_version
             s["topology"] = topology
-            # Each frame's vertices a dataset of its own: ParaView's reader takes the geometry of a
-            # frame whole (a HyperSlab of one [T, V, 2] array works, but makes it complain that it
-            # cannot cache it).
-            velocity = s.create_dataset("velocity", (t, n, 3), np.float64, chunks=(1, n, 3))
+            # Each frame's vertices and per-body values datasets of their own: the Xdmf3 readers skip
+            # an attribute given as a HyperSlab of one [T, N] array, and the older reader complains
+            # that it cannot cache one.
             for k in range(t):
                 s[f"vertices/{k}"] = run.world_vertices(k)
-                velocity[k, :, :2] = run._file["bodies/velocity"][k]
+                velocity = np.zeros((n, 3))
+                velocity[:, :2] = run.velocity[k]
+                s[f"velocity/{k}"] = velocity
+                s[f"angular_velocity/{k}"] = run.angular_velocity[k]
             s["collisions/points"] = np.column_stack([points, np.zeros(len(points))]) if len(points) else \
                 np.zeros((0, 3))
             for name, col in columns.items():
@@ -116,9 +120,9 @@ def export(run_path, out=None):
             geo = ET.SubElement(g, "Geometry", GeometryType="XY")
             _item(geo, (v, 2), f"{side_ref}:/vertices/{k}")
             a = ET.SubElement(g, "Attribute", Name="velocity", AttributeType="Vector", Center="Cell")
-            _hyperslab(a, k, t, (n, 3), f"{side_ref}:/velocity")
+            _item(a, (n, 3), f"{side_ref}:/velocity/{k}")
             a = ET.SubElement(g, "Attribute", Name="angular_velocity", AttributeType="Scalar", Center="Cell")
-            _hyperslab(a, k, t, (n,), f"{run_ref}:/bodies/angular_velocity")
+            _item(a, (n,), f"{side_ref}:/angular_velocity/{k}")
             for name, number, precision in fixed_attrs:
                 a = ET.SubElement(g, "Attribute", Name=name, AttributeType="Scalar", Center="Cell")
                 _item(a, (n,), f"{run_ref}:/bodies/{name}", number, precision)
@@ -142,13 +146,3 @@ def export(run_path, out=None):
         os.replace(tmp_side, side_path)
         os.replace(tmp_xdmf, xdmf_path)
     return xdmf_path
-
-
-def _hyperslab(parent, frame, frames, shape, path):
-    """Frame `frame` of a dataset [frames, *shape], as a HyperSlab DataItem of shape `shape`."""
-    rank = 1 + len(shape)
-    slab = ET.SubElement(parent, "DataItem", ItemType="HyperSlab", Type="HyperSlab",
-                         Dimensions=" ".join(str(d) for d in shape))
-    sel = ET.SubElement(slab, "DataItem", Dimensions=f"3 {rank}", Format="XML", NumberType="Int")
-    sel.text = " ".join([str(frame)] + ["0"] * len(shape) + ["1"] * rank + ["1"] + [str(d) for d in shape])
-    _item(slab, (frames,) + tuple(shape), path)
