@@ -35,6 +35,32 @@ struct PassIo {
   std::array<double, 3>* q;
 };
 
+/// The end of pass_group: the later terms' points, each term in its turn and its points in
+/// order (the first term's went straight into q), then each lane's sums to its body.
+template <bool rotational, int kTerms, unsigned kForm>
+FLOEDEM_LANES void finish_group(const DragPass::Shape& shape, const DragPass::Group& g, const PassIo& io,
+                                unsigned mask, const Held* held, const std::uint32_t* base, std::uint32_t edges,
+                                v4d q0, v4d q1, v4d q2) {
+  const int terms = kTerms > 0 ? kTerms : shape.terms;
+  auto is_form = [&](int t) { return kTerms > 0 ? ((kForm >> t) & 1u) != 0 : shape.form[static_cast<std::size_t>(t)]; };
+#pragma GCC unroll 4
+  for (int t = 1; t < terms; ++t) {
+    const std::uint32_t n = edges * (is_form(t) ? 2 : 3);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const Held& h = held[base[t] + k];
+      q0 += h.x;
+      q1 += h.y;
+      if (rotational) q2 += h.t;
+    }
+  }
+  double out0[kLanes], out1[kLanes], out2[kLanes];
+  store(out0, q0);
+  store(out1, q1);
+  store(out2, q2);
+  for (int l = 0; l < kLanes; ++l)
+    if (mask & (1u << l)) io.q[g.body[l]] = {out0[l], out1[l], out2[l]};
+}
+
 /// One group of four floes, every term of the run (drag_pass.hpp): the operations of
 /// form_quad and skin_quad (drag.cpp), each point formed from the corners as edge_points and
 /// area_points form it, turned into the world once for every term.
@@ -168,23 +194,7 @@ FLOEDEM_LANES void pass_group(const DragPass::Shape& shape, const DragPass::Grou
     }
     if (any_skin) ax = bx, ay = by;
   }
-  // The later terms, each in its turn, their points in order.
-#pragma GCC unroll 4
-  for (int t = 1; t < terms; ++t) {
-    const std::uint32_t n = edges * (is_form(t) ? 2 : 3);
-    for (std::uint32_t k = 0; k < n; ++k) {
-      const Held& h = held[base[t] + k];
-      q0 += h.x;
-      q1 += h.y;
-      if (rotational) q2 += h.t;
-    }
-  }
-  double out0[kLanes], out1[kLanes], out2[kLanes];
-  store(out0, q0);
-  store(out1, q1);
-  store(out2, q2);
-  for (int l = 0; l < kLanes; ++l)
-    if (mask & (1u << l)) io.q[g.body[l]] = {out0[l], out1[l], out2[l]};
+  finish_group<rotational, kTerms, kForm>(shape, g, io, mask, held, base, edges, q0, q1, q2);
 }
 
 /// One group's rate bounds, term by term: DistributedDrag::add_slab_bound for quadratic drag
