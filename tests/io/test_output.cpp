@@ -41,6 +41,21 @@ const std::string kScene = test::header_toml(1.0, 0.01, 0.3, 0.3, "[engine.nativ
                            test::body_toml({"a", test::box({5, 5}, 10, 10), {1.0, 0.0}}) +
                            test::body_toml({"b", {{10.5, 0}, {20.5, 0}, {10.5, 12}}, {}, 0.1});
 
+/// kScene run into a new temporary directory named after `tag`; the output's path.
+std::string run_small_scene(const std::string& tag) {
+  const std::string out = (test::temp_dir(tag) / "r.h5").string();
+  RunOptions o;
+  o.output = out;
+  run_scene(test::scene_from(kScene), o);
+  return out;
+}
+
+std::int64_t format_of(const H5::H5File& f) {
+  std::int64_t format = 0;
+  f.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
+  return format;
+}
+
 /// A 10 m square floe, 1 m thick, and a fixed wall at x = 0, a 0.5 m/s current towards the
 /// wall, 60 s at dt 0.1 s; the wall's load recorded every 10 steps.
 std::string wall_and_floe(const std::string& floe_polygon, const std::string& floe_velocity) {
@@ -76,9 +91,7 @@ TEST_CASE("output layout: bodies, frames, contacts, attributes", "[output]") {
   CHECK(string_attribute(f.openGroup("/"), "scenario") == kScene);
   CHECK(string_attribute(f.openGroup("/"), "overrides") == "run.output_every=10");
   CHECK_FALSE(string_attribute(f.openGroup("/"), "floedem_version").empty());
-  std::int64_t format = 0;
-  f.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
-  CHECK(format == kOutputFormatVersion);
+  CHECK(format_of(f) == kOutputFormatVersion);
   double dt = 0;
   f.openAttribute("dt").read(H5::PredType::NATIVE_DOUBLE, &dt);
   CHECK(dt == 0.01);
@@ -241,11 +254,7 @@ TEST_CASE("run summary: the headline figures are the file's means over the secon
 }
 
 TEST_CASE("a run's output of another format_version is refused, naming the file and both versions", "[output]") {
-  const fs::path dir = test::temp_dir("format");
-  const std::string out = (dir / "r.h5").string();
-  RunOptions o;
-  o.output = out;
-  run_scene(test::scene_from(kScene), o);
+  const std::string out = run_small_scene("format");
   {
     H5::H5File f(out, H5F_ACC_RDWR);
     const std::int64_t newer = kOutputFormatVersion + 1;
@@ -324,9 +333,7 @@ TEST_CASE("format 1 files, with variable-length strings, are read and continued 
   const ResumeResult r = resume_run(checkpointed, {"run.duration=" + std::to_string(before.duration + 10.0)}, false);
   CHECK(r.ran);
   H5::H5File f(checkpointed, H5F_ACC_RDONLY);
-  std::int64_t format = 0;
-  f.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
-  CHECK(format == 1);
+  CHECK(format_of(f) == 1);
   CHECK(f.openAttribute("status").getStrType().isVariableStr());
   CHECK(f.openDataSet("/bodies/name").getStrType().isVariableStr());
   const StoredRun after = read_stored_run(checkpointed);
@@ -335,15 +342,9 @@ TEST_CASE("format 1 files, with variable-length strings, are read and continued 
 }
 
 TEST_CASE("format 2 stores every string fixed-length", "[output]") {
-  const fs::path dir = test::temp_dir("format2");
-  const std::string out = (dir / "r.h5").string();
-  RunOptions o;
-  o.output = out;
-  run_scene(test::scene_from(kScene), o);
+  const std::string out = run_small_scene("format2");
   H5::H5File f(out, H5F_ACC_RDONLY);
-  std::int64_t format = 0;
-  f.openAttribute("format_version").read(H5::PredType::NATIVE_INT64, &format);
-  CHECK(format == 2);
+  CHECK(format_of(f) == 2);
   auto fixed = [](const H5::StrType& t) { return !t.isVariableStr(); };
   H5::Group root = f.openGroup("/");
   for (int k = 0; k < root.getNumAttrs(); ++k) {
