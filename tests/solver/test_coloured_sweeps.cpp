@@ -267,7 +267,7 @@ TEST_CASE("coloured sweeps: the native engine gives the same state on 1 and 2 th
 TEST_CASE("coloured sweeps: an island solved on every thread at once gives the same state on 1 and 2 threads",
           "[solver][coloured][threads]") {
   // An island of at least kColouredOnThreads manifolds is left out of the blocks of islands and
-  // solved after them, its colours swept on the pool (NativeEngine::solve_contacts), the path
+  // solved after them, its colours swept on the pool (IslandStage::solve), the path
   // of a packed field on its wall; the fields of the tests above do not pack into one that
   // large within their steps. Here 50 x 50 floes of 10 m, each touching its neighbours (4 900
   // manifolds, one island), closing on the middle (0.2 m/s at the edges, neighbours 8 mm/s

@@ -1,5 +1,5 @@
 // Contact islands (native/solver/contact_islands.cpp) and the velocity solve island by island
-// (native_engine.cpp, solve_contacts).
+// (island_stage.cpp, IslandStage::solve).
 #include <catch2/catch.hpp>
 
 #include "run/stepper.hpp"
