@@ -4,6 +4,7 @@
 // coloured_sweeps.hpp), its energy checked, and heavy-light islands the sweeps cannot hold
 // solved directly (island_solve.hpp). It owns the islands, the sweeps' work space and the
 // solver's counts.
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -46,13 +47,16 @@ class IslandStage {
     return static_cast<std::int64_t>(islands_.manifolds(i).size()) >= ctx.settings.coloured_from;
   }
   void solve_islands_directly(StepContext& ctx, std::span<Manifold> manifolds, double energy_before);
-  /// The sweeps' limits: extra sweeps while a point would close by more than the allowed overlap within the step.
-  static SweepLimits sweep_limits(const StepContext& ctx) {
+  /// The sweeps' limits for an island: extra sweeps while a point would close by more than the
+  /// allowed overlap within the step; `impact`: a small island with a collision this step.
+  static SweepLimits sweep_limits(const StepContext& ctx, bool impact) {
     const NativeSettings& s = ctx.settings;
-    return {s.velocity_iterations, s.tolerance, s.extra_iterations, s.allowed_penetration / ctx.dt};
+    return {impact ? std::max(s.velocity_iterations, s.collision_iterations) : s.velocity_iterations, s.tolerance,
+            s.extra_iterations, s.allowed_penetration / ctx.dt};
   }
 
   static constexpr std::size_t kIslandGrain = 8;  // islands per block
+  static constexpr std::size_t kImpactManifolds = 64;  // islands up to this size swept to collision_iterations
   static constexpr int kFrictionRounds = 8;       // cut friction, solve the normals again (below)
 
   bool heavy_light_ = false;  // direct solve on, and two moving bodies differ by its mass ratio

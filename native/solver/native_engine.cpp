@@ -71,6 +71,7 @@ EngineInfo NativeEngine::info() const {
   i.settings = {
       {"velocity_iterations", std::to_string(s.velocity_iterations)},
       {"extra_iterations", std::to_string(s.extra_iterations)},
+      {"collision_iterations", std::to_string(s.collision_iterations)},
       {"accelerate", s.accelerate ? "true" : "false"},
       {"coloured_from", std::to_string(s.coloured_from)},
       {"tolerance", setting_text(s.tolerance)},

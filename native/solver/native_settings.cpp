@@ -13,6 +13,7 @@ NativeSettings read_native_settings(const Scene& scene) {
   TableReader r(it->second, scene.source_path, "engine.native");
   s.velocity_iterations = static_cast<int>(r.integer("velocity_iterations", s.velocity_iterations, 1, 1'000'000));
   s.extra_iterations = static_cast<int>(r.integer("extra_iterations", s.extra_iterations, 0, 1'000'000));
+  s.collision_iterations = static_cast<int>(r.integer("collision_iterations", s.collision_iterations, 1, 1'000'000));
   s.tolerance = r.real("tolerance", s.tolerance, Range{0.0, 1.0, false, true});
   s.warm_start = r.boolean("warm_start", s.warm_start);
   s.accelerate = r.boolean("accelerate", s.accelerate);

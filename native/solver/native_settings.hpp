@@ -9,6 +9,7 @@ namespace floedem {
 struct NativeSettings {
   int velocity_iterations = 50;      ///< most Gauss-Seidel sweeps per step, unless ...
   int extra_iterations = 450;        ///< ... a point is left closing by more than allowed_penetration in the step: up to this many more
+  int collision_iterations = 50;     ///< ... an island with a collision this step: at most this many (Newton's law converged)
   double tolerance = 1e-10;          ///< stop sweeping when max |dP| <= tolerance * max |P|
   bool warm_start = true;            ///< start from last step's resting impulses
   bool accelerate = true;            ///< conjugate-gradient step after each sweep (NNCG)

@@ -29,9 +29,9 @@ struct After {
 
 // `coloured`: the native engine's coloured sweeps (coloured_sweeps.hpp), whose local solve is
 // the same law in other arithmetic (reciprocals), held to the same closed forms.
-After run_one_step(const Impact& c, bool coloured = false) {
-  const std::string native = std::string("[engine.native]\nvelocity_iterations = 500\ntolerance = 0.0\n") +
-                             (coloured ? "coloured_sweeps = true\n" : "");
+After run_one_step(const Impact& c, bool coloured = false,
+                   const std::string& sweeps = "velocity_iterations = 500\ntolerance = 0.0\n") {
+  const std::string native = "[engine.native]\n" + sweeps + (coloured ? "coloured_sweeps = true\n" : "");
   const Scene s = test::scene_from(test::header_toml(0.01, 0.01, c.e, c.mu, native) + test::body_toml(c.a) +
                                    test::body_toml(c.b));
   auto engine = test::native(s);
@@ -197,6 +197,23 @@ TEST_CASE("head-on impact of equal squares: restitution, momentum and energy exa
     }
     CHECK(j == Approx((1.0 + e) * kMass / 2).epsilon(1e-10));
   }
+}
+
+TEST_CASE("an impact is swept to convergence past a resting island's few sweeps", "[impact]") {
+  // Two squares face to face: two points, which Gauss-Seidel couples through the bodies'
+  // rotation, so five sweeps leave the restitution 2.5e-4 off. collision_iterations (50 by
+  // default) lets an island with a collision go on to the tolerance; held to 5 as well, the
+  // same impact misses the 1e-9 of the test above.
+  Impact c;
+  c.e = 0.1;
+  c.a = {"a", test::box({5, 5}, kSide, kSide), {1.0, 0.0}};
+  c.b = {"b", test::box({15, 5}, kSide, kSide)};
+  auto restitution_error = [&](const std::string& sweeps) {
+    const After r = run_one_step(c, false, sweeps);
+    return std::abs(r.state.velocity[1].x - r.state.velocity[0].x - c.e);
+  };
+  CHECK(restitution_error("velocity_iterations = 5\n") <= 1e-9);
+  CHECK(restitution_error("velocity_iterations = 5\ncollision_iterations = 5\n") > 1e-9);
 }
 
 TEST_CASE("half-overlapping faces: two-point impact against the closed form", "[impact]") {
