@@ -66,16 +66,6 @@ bool contacts_gain_energy(const StepContext& ctx, std::span<const Manifold> mani
          before;
 }
 
-// Whether a point of the island's manifolds is a collision this step.
-bool has_collision(std::span<const Manifold> all, std::span<const std::int32_t> island) {
-  for (const std::int32_t k : island) {
-    const Manifold& m = all[static_cast<std::size_t>(k)];
-    for (int j = 0; j < m.point_count; ++j)
-      if (m.points[j].kind == ContactKind::collision) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 IslandStage::IslandStage(const Scene& scene, const StepContext& ctx) {
@@ -141,7 +131,10 @@ void IslandStage::solve(StepContext& ctx, std::span<Manifold> manifolds, std::sp
     resize_with_headroom(island_velocity_, islands_.body_count());
     resize_with_headroom(island_angular_velocity_, islands_.body_count());
   }
-  for (IslandWork& w : island_work_) w.longest = w.cold_restarts = 0;
+  for (IslandWork& w : island_work_) {
+    w.longest = w.cold_restarts = 0;
+    w.out_of_sweeps = false;
+  }
   // A large island swept in colour order (the packed field's one large island) is left out of
   // the blocks and solved after them on every thread at once, its colours swept on the pool:
   // on two threads, the rest of the islands and it would otherwise wait for the one thread
@@ -161,9 +154,11 @@ void IslandStage::solve(StepContext& ctx, std::span<Manifold> manifolds, std::sp
       w.longest = std::max(w.longest, solve_island(ctx, manifolds, i, checked, w, true));
     }
   int longest = 0;
+  bool out_of_sweeps = false;
   for (const IslandWork& w : island_work_) {
     longest = std::max(longest, w.longest);
     cold_restarts_ += w.cold_restarts;
+    out_of_sweeps = out_of_sweeps || w.out_of_sweeps;
   }
   total_sweeps_ += longest;
   std::size_t solved = n;  // a redetection counts the islands it solved again
@@ -177,7 +172,7 @@ void IslandStage::solve(StepContext& ctx, std::span<Manifold> manifolds, std::sp
   // ratio between any two moving bodies never looks (heavy_light_). It looks at every island,
   // those a redetection kept too: one that the step's first pass left out of sweeps was solved
   // directly then, unless that would have made energy, and may be tried again.
-  if (heavy_light_ && longest >= settings.velocity_iterations) solve_islands_directly(ctx, manifolds, before);
+  if (heavy_light_ && out_of_sweeps) solve_islands_directly(ctx, manifolds, before);
 }
 
 int IslandStage::solve_island(StepContext& ctx, std::span<Manifold> manifolds_all, std::size_t island, bool checked,
@@ -208,23 +203,25 @@ int IslandStage::solve_island(StepContext& ctx, std::span<Manifold> manifolds_al
                               island_bundles_[island + 1] - island_bundles_[island]);
     space.colours_given = true;  // by solve()
   }
-  // An impact among a few bodies is swept to convergence (up to collision_iterations): its
-  // impulse sets the velocities after it by Newton's law, which a resting island's few sweeps
-  // would leave 1e-7 of the approach speed short (two floes head-on, five sweeps). A resting
-  // island, or a pack jostling on its neighbours, needs only to hold (the extra sweeps while a
-  // point closes faster than allowed): on the packed 1k field, every island with a collision
-  // swept to 50 made 33 sweeps a step of the 5.
-  const bool impact = manifolds.size() <= kImpactManifolds && has_collision(manifolds_all, manifolds);
-  int sweeps = solve_velocities(manifolds_all, manifolds, s, sweep_limits(ctx, impact), space,
+  const SweepLimits limits = sweep_limits(ctx, manifolds.size());
+  // Out of sweeps: the island spent its count (the direct solve's trigger looks then).
+  auto spent = [&](int sweeps) {
+    if (sweeps >= limits.iterations) work.out_of_sweeps = true;
+    return sweeps;
+  };
+  // A large island's few sweeps are plain: NNCG's conjugate steps pay over tens of sweeps (a
+  // load carried across a chain in N sweeps, not N^2), and over five its pass over the points
+  // cost the packed 1k field's solve 0.41 against 0.28 ms a step.
+  int sweeps = solve_velocities(manifolds_all, manifolds, s, limits, space,
                                 {.warm_start = ctx.settings.warm_start,
-                                 .accelerate = ctx.settings.accelerate,
+                                 .accelerate = ctx.settings.accelerate && !large_island(ctx, manifolds.size()),
                                  .colour = colour,
                                  .threads = threads});
-  if (!checked) return sweeps;
+  if (!checked) return spent(sweeps);
   double pushed = 0.0;  // the work of towed bodies on this island's floes (contacts_gain_energy)
   if (ctx.has_prescribed)
     for (const std::int32_t k : manifolds) pushed += kinematic_work(s, manifolds_all[static_cast<std::size_t>(k)]);
-  if (kinetic_energy_of(s, bodies) - 2.0 * pushed <= before) return sweeps;
+  if (kinetic_energy_of(s, bodies) - 2.0 * pushed <= before) return spent(sweeps);
   for (std::size_t x = 0; x < bodies.size(); ++x) {
     s.velocity[bodies[x]] = island_velocity_[at + x];
     s.angular_velocity[bodies[x]] = island_angular_velocity_[at + x];
@@ -234,10 +231,10 @@ int IslandStage::solve_island(StepContext& ctx, std::span<Manifold> manifolds_al
     for (int j = 0; j < m.point_count; ++j) m.points[j].normal_impulse = m.points[j].tangent_impulse = 0.0;
   }
   space.colours_given = false;  // the first solve kept its list of rows beyond the colours there: colour again
-  sweeps += solve_velocities(manifolds_all, manifolds, s, sweep_limits(ctx, impact), space,  // plain sweeps: no energy made
+  sweeps += solve_velocities(manifolds_all, manifolds, s, limits, space,  // plain sweeps: no energy made
                              {.colour = colour, .threads = threads});
   ++work.cold_restarts;
-  return sweeps;
+  return spent(sweeps);
 }
 
 void IslandStage::solve_islands_directly(StepContext& ctx, std::span<Manifold> manifolds, double before) {

@@ -39,6 +39,7 @@ class IslandStage {
   struct IslandWork {
     int longest = 0;        // most sweeps an island of the block took
     int cold_restarts = 0;  // islands of the block solved again from zero
+    bool out_of_sweeps = false;  // an island of the block spent its sweeps (sweep_limits)
   };
   int solve_island(StepContext& ctx, std::span<Manifold> manifolds, std::size_t island, bool checked,
                    IslandWork& work, bool threads);
@@ -47,16 +48,21 @@ class IslandStage {
     return static_cast<std::int64_t>(islands_.manifolds(i).size()) >= ctx.settings.coloured_from;
   }
   void solve_islands_directly(StepContext& ctx, std::span<Manifold> manifolds, double energy_before);
-  /// The sweeps' limits for an island: extra sweeps while a point would close by more than the
-  /// allowed overlap within the step; `impact`: a small island with a collision this step.
-  static SweepLimits sweep_limits(const StepContext& ctx, bool impact) {
+  /// Whether an island of `manifolds` manifolds is large (NativeSettings::large_island_manifolds).
+  static bool large_island(const StepContext& ctx, std::size_t manifolds) {
+    return static_cast<std::int64_t>(manifolds) >= ctx.settings.large_island_manifolds;
+  }
+  /// The sweeps' limits for an island of `manifolds` manifolds: a large one's own count, and for
+  /// every island extra sweeps while a point would close by more than the allowed overlap
+  /// within the step.
+  static SweepLimits sweep_limits(const StepContext& ctx, std::size_t manifolds) {
     const NativeSettings& s = ctx.settings;
-    return {impact ? std::max(s.velocity_iterations, s.collision_iterations) : s.velocity_iterations, s.tolerance,
+    const bool large = large_island(ctx, manifolds);
+    return {large ? std::min(s.velocity_iterations, s.large_island_iterations) : s.velocity_iterations, s.tolerance,
             s.extra_iterations, s.allowed_penetration / ctx.dt};
   }
 
   static constexpr std::size_t kIslandGrain = 8;  // islands per block
-  static constexpr std::size_t kImpactManifolds = 64;  // islands up to this size swept to collision_iterations
   static constexpr int kFrictionRounds = 8;       // cut friction, solve the normals again (below)
 
   bool heavy_light_ = false;  // direct solve on, and two moving bodies differ by its mass ratio

@@ -71,9 +71,10 @@ EngineInfo NativeEngine::info() const {
   i.settings = {
       {"velocity_iterations", std::to_string(s.velocity_iterations)},
       {"extra_iterations", std::to_string(s.extra_iterations)},
-      {"collision_iterations", std::to_string(s.collision_iterations)},
       {"accelerate", s.accelerate ? "true" : "false"},
       {"coloured_from", std::to_string(s.coloured_from)},
+      {"large_island_manifolds", std::to_string(s.large_island_manifolds)},
+      {"large_island_iterations", std::to_string(s.large_island_iterations)},
       {"tolerance", setting_text(s.tolerance)},
       {"warm_start", s.warm_start ? "true" : "false"},
       {"position_iterations", std::to_string(s.position_iterations)},

@@ -9,7 +9,6 @@ namespace floedem {
 struct NativeSettings {
   int velocity_iterations = 50;      ///< most Gauss-Seidel sweeps per step, unless ...
   int extra_iterations = 450;        ///< ... a point is left closing by more than allowed_penetration in the step: up to this many more
-  int collision_iterations = 50;     ///< ... an island with a collision this step: at most this many (Newton's law converged)
   double tolerance = 1e-10;          ///< stop sweeping when max |dP| <= tolerance * max |P|
   bool warm_start = true;            ///< start from last step's resting impulses
   bool accelerate = true;            ///< conjugate-gradient step after each sweep (NNCG)
@@ -18,7 +17,13 @@ struct NativeSettings {
   /// report's scenes (docs/architecture.md). `coloured_sweeps = true` in a scene sets it to 0
   /// (every island), `false` to never.
   std::int64_t coloured_from = 1024;
-  int position_iterations = 4;       ///< position-projection sweeps per step (0: none)
+  /// An island of at least `large_island_manifolds` manifolds (a packed pack) is swept at most
+  /// `large_island_iterations` times (and the extra sweeps), smaller ones velocity_iterations:
+  /// a pack needs its overlap held, not its impulses converged; a few bodies' impacts and
+  /// pressed chains need them converged (scenarios/README.md).
+  std::int64_t large_island_manifolds = 1024;
+  int large_island_iterations = 3;
+  int position_iterations = 10;      ///< most position-projection sweeps per step (0: none); they stop once the deepest overlap is within 1.5 allowed_penetration
   double position_correction = 0.2;  ///< fraction of the overlap removed per sweep
   double allowed_penetration = 1e-3; ///< m, overlap left alone (keeps contacts persistent)
   double max_correction = 0.2;       ///< m, largest push of one sweep at one point

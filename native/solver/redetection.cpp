@@ -12,9 +12,17 @@ Redetection::Redetection(const StepContext& ctx) {
   outran_.assign(n, 0);
   body_island_.assign(n, -1);
   resolve_.assign(n, 0);
+  // A body is listed at most once: room for all, so that the first redetection to mark a
+  // packed field's large island does not allocate mid-run.
+  resolve_list_.reserve(n);
 }
 
 void Redetection::run(StepContext& ctx, ContactPipeline& pipeline, IslandStage& islands, SleepSets& sleep) {
+  // A redetection builds the step's list again over solved_'s storage (redetect): room kept for
+  // as many manifolds as the list has, so that the first redetection of a run, however late,
+  // does not allocate (it grows when the list itself does).
+  if (ctx.settings.redetect && solved_.capacity() < pipeline.manifolds().capacity())
+    solved_.reserve(pipeline.manifolds().capacity());
   for (int pass = 0; ctx.settings.redetect && pass < kMaxPasses && outran_reach(ctx, pipeline, islands.islands());
        ++pass) {
     const bool unseen = meets_unseen_contact(ctx, pipeline);

@@ -9,8 +9,9 @@ solver, not agreement checks, so a target missed is reported here and is not a d
 
 Penetration is shown beside the time: an engine that is faster by letting floes overlap more
 has not won. The benchmark scenes carry no solver settings, so two sets of runs are made of
-them: native's defaults (what a user gets: NNCG and extra sweeps while a point closes by more
-than the allowed overlap, each island in pair order or in colour order by its size), and every
+them: native's defaults (what a user gets: a large island's few plain sweeps and a smaller
+one's NNCG, extra sweeps while a point closes by more than the allowed overlap, each island in
+pair order or in colour order by its size; scenarios/README.md, `[engine.native]`), and every
 engine at the same 10 iterations (native as plain Gauss-Seidel in colour order), the comparison
 that is fair to the other engines. Each table says which it is. The same trade is swept on the
 1k field (iterations and dt per engine: cost against mean overlap). Every run here is single

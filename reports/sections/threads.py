@@ -15,8 +15,7 @@ from report_runner import Run
 from sections.speed import STAGE_LABELS, equal, read_row, stages, write_rows
 
 # Colour order with 10 plain sweeps (the speed section's equal iterations), and pair order with
-# native's defaults otherwise (50 sweeps followed by NNCG steps, up to 450 more where a point
-# still closes too fast).
+# native's defaults otherwise.
 IDENTICAL_ORDERS = {"coloured": equal("native"), "pairs": ["engine.native.coloured_sweeps=false"]}
 
 

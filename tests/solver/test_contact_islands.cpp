@@ -24,7 +24,7 @@ std::vector<std::int32_t> list(std::span<const std::int32_t> s) { return {s.begi
 // Two floes that meet obliquely with spin (collision, friction, rotation) near the origin and,
 // with `pressed_row`, 1 km away a row of ten floes pushed along x onto a fixed wall by a force
 // on the last one: a pressed chain that takes every sweep the limits give it.
-Scene scene(bool pressed_row) {
+std::string scene_text(bool pressed_row) {
   std::string text = test::header_toml(10.0, 0.05, 0.3, 0.4);
   text += test::body_toml({"a", test::box({0, 0}, 6, 4, 0.2), {0.6, 0.1}, 0.05});
   text += test::body_toml({"b", test::box({9, 1.5}, 5, 5, -0.3), {-0.4, 0.0}, -0.02});
@@ -34,7 +34,11 @@ Scene scene(bool pressed_row) {
       text += test::body_toml({"row-" + std::to_string(k), test::box({1000.5 + 1.0 * k, 0}, 1, 1), {}, 0.0, false,
                                k == 9 ? Vec2{-2e4, 0.0} : Vec2{}});
   }
-  return test::scene_from(text);
+  return text;
+}
+
+Scene scene(bool pressed_row, const std::vector<std::string>& sets = {}) {
+  return test::scene_from(scene_text(pressed_row), sets);
 }
 
 }  // namespace
@@ -105,4 +109,22 @@ TEST_CASE("contact islands: an island's solve does not depend on the rest of the
     CHECK(same_bits(a.state().velocity[i].x, b.state().velocity[i].x));
     CHECK(same_bits(a.state().angular_velocity[i], b.state().angular_velocity[i]));
   }
+}
+
+TEST_CASE("contact islands: a large island gets a few plain sweeps, a smaller one sweeps to converge", "[islands]") {
+  // The pressed row of ten floes, an island of ten manifolds at most: taken for a large island
+  // (large_island_manifolds = 1), never more than large_island_iterations sweeps a step (the
+  // extra sweeps off, so that the count is the limit's); below the threshold, the row's hard
+  // work of the test above.
+  auto mean_sweeps = [](const std::string& threshold) {
+    Stepper s(scene(true, {"engine.native.large_island_manifolds=" + threshold, "engine.native.large_island_iterations=2",
+                           "engine.native.extra_iterations=0"}),
+              "native");
+    for (int step = 0; step < 200; ++step) s.step();
+    return std::stod(s.engine().info().settings.at("mean_sweeps_per_step"));
+  };
+  const double large = mean_sweeps("1"), small = mean_sweeps("11");
+  CHECK(large > 0.0);
+  CHECK(large <= 2.0);
+  CHECK(small > 20.0);
 }

@@ -161,7 +161,8 @@ TEST_CASE("the default sweeps hold a pressed row of 50 floes, plain sweeps as ma
   //
   // Held means no creep into the wall: over the last second the overlap stays at what the
   // position projection leaves (the allowed 1 mm; the projection stops at 1.5 times it), where
-  // plain sweeps as many pile 8.7 to 10.6 mm (28 seeds of this row; defaults 1.0 to 1.1 mm).
+  // plain sweeps as many pile 8.7 to 10.6 mm with 4 position sweeps a step (28 seeds of this
+  // row; defaults 1.0 to 1.1 mm), and 4.9 mm with the default 10 (this seed).
   // That the row comes to rest is not asked. Where two neighbours' faces are not flush they
   // touch at one corner, and the flush runs of floes between such corners can turn as rigid
   // bodies about them, each corner a hinge that does not slip: the pressed row buckles between
@@ -180,7 +181,7 @@ TEST_CASE("the default sweeps hold a pressed row of 50 floes, plain sweeps as ma
   // The same 50 sweeps, plain and never more: the chain creeps into the wall.
   const RowResult plain = press_row(0.3, "extra_iterations = 0\naccelerate = false\n");
   CHECK(plain.max_overlap > 2.0 * fast.max_overlap);
-  CHECK(plain.max_overlap_end > 5e-3);
+  CHECK(plain.max_overlap_end > 4e-3);  // over twice the defaults' bound above
   // And the acceleration earns its pass: the sweeps made with room for 1000 a step, stopping
   // where no point would close by more than 0.01 mm within the step (1 mm/s).
   const std::string kToClose = "velocity_iterations = 1\nextra_iterations = 999\nallowed_penetration = 1e-5\n";
