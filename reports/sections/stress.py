@@ -234,10 +234,11 @@ def write(ctx):
            "not hold would close within it, finds the step's contacts again and solves it again (the row "
            "\"without redetect\" turns it off). A jammed pack is Gauss-Seidel's other limit: the walls' reaction "
            "travels one contact per sweep, so a pack N floes deep needs of order N^2 sweeps, and 50 leave it "
-           "closing by centimetres a step at dt 0.5 s (rows \"plain sweeps\"). Native follows each sweep with a "
-           "nonsmooth conjugate-gradient step (Silcowitz, Niebe and Erleben 2010), which carries the reaction "
-           "across the pack in of order N, and sweeps on (up to 450 more) while a point would still close by more "
-           "than the allowed overlap (1 mm) within the step.", ""]
+           "closing by centimetres a step at dt 0.5 s (rows \"plain sweeps\"). In an island below 1 024 manifolds "
+           "(a pressed chain) native follows each sweep with a nonsmooth conjugate-gradient step (Silcowitz, Niebe "
+           "and Erleben 2010), which carries the reaction along it in of order N; a larger island (the jam's pack) "
+           "gets 3 plain sweeps. Either sweeps on (up to 450 more) while a point would still close by more than the "
+           "allowed overlap (1 mm) within the step, and the position projection takes back what is left.", ""]
     jam = [o for o in outs if not o.failed and getattr(o, "load", None) is not None]
     if jam:
         md += ["Ice load on the grounded iceberg in the jam and on the wall of the resting column (`/loads`, 1 s means "
