@@ -117,9 +117,10 @@ TEST_CASE("contact islands: a large island gets a few plain sweeps, a smaller on
   // extra sweeps off, so that the count is the limit's); below the threshold, the row's hard
   // work of the test above.
   auto mean_sweeps = [](const std::string& threshold) {
-    Stepper s(scene(true, {"engine.native.large_island_manifolds=" + threshold, "engine.native.large_island_iterations=2",
-                           "engine.native.extra_iterations=0"}),
-              "native");
+    // The Stepper keeps a reference to its scene: the scene must outlive it.
+    const Scene row = scene(true, {"engine.native.large_island_manifolds=" + threshold,
+                                   "engine.native.large_island_iterations=2", "engine.native.extra_iterations=0"});
+    Stepper s(row, "native");
     for (int step = 0; step < 200; ++step) s.step();
     return std::stod(s.engine().info().settings.at("mean_sweeps_per_step"));
   };
