@@ -37,8 +37,8 @@ the page and the CSVs disagree.
   the deepest and mean penetration, heap allocations per step, peak memory, and with
   `--stages` the mean ms per step of each stage (`stage_ms`; the stages are listed in
   [architecture.md](architecture.md)). The `work` column counts the engine's work per timed
-  step (native: `sweeps`, its longest island's velocity sweeps; `islands`; `redetections`, the
-  steps solved again), so that a step that does more work is told from one whose work costs
+  step (native: `sweeps`, its longest island's velocity sweeps; `position_sweeps`, the position
+  projection's; `islands`; `redetections`, the steps solved again), so that a step that does more work is told from one whose work costs
   more. Each row names the machine (host, CPU model with family, model and cache sizes,
   threads) and the build.
 - **One run at a time, single thread**, unless threads are what is measured: a timing that

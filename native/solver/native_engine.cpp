@@ -30,9 +30,12 @@ class NativeEngine final : public Engine {
   void time_stages(bool on) override { stages_.enable(on); }
   void add_stage_times(std::vector<StageTime>& out) const override { stages_.add_to(out); }
   // sweeps: each step's longest island's velocity sweeps (the step's critical path on any
-  // number of threads); islands: the islands solved; redetections: the steps solved again.
+  // number of threads); islands: the islands solved; redetections: the steps solved again;
+  // position_sweeps: the projection's sweeps (counted since the engine was made, so a resumed
+  // run's count starts at its checkpoint).
   void add_work_counts(std::vector<WorkCount>& out) const override {
     out.push_back({"sweeps", static_cast<double>(islands_.total_sweeps())});
+    out.push_back({"position_sweeps", static_cast<double>(projection_.sweeps)});
     out.push_back({"islands", static_cast<double>(islands_.total_islands())});
     out.push_back({"redetections", static_cast<double>(redetection_.count())});
   }

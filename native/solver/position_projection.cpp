@@ -48,11 +48,13 @@ class Projection {
     work_.moved_bodies.clear();
     if (settings_.position_iterations <= 0) return 0.0;
     double deepest = first_sweep();
+    ++work_.sweeps;
     if (settings_.position_iterations == 1 || deepest <= 1.5 * settings_.allowed_penetration) return deepest;
     list_stale();
     marking_ = true;
     for (int iteration = 1; iteration < settings_.position_iterations; ++iteration) {
       deepest = later_sweep();
+      ++work_.sweeps;
       if (deepest <= 1.5 * settings_.allowed_penetration) break;
     }
     return deepest;

@@ -160,6 +160,7 @@ struct SweepOptions {
 /// allocation per step in the steady state).
 struct ProjectionWork {
   std::uint64_t clock = 0;               ///< evaluations of a manifold so far (never reset)
+  std::int64_t sweeps = 0;               ///< projection sweeps made so far (a work count, not state)
   std::vector<std::uint64_t> moved;      ///< per body: the evaluation that last changed its pose
   std::vector<std::uint64_t> evaluated;  ///< per manifold: the evaluation that last measured its gaps
   std::vector<double> depth;             ///< ... and the deepest of those gaps then (m, >= 0)

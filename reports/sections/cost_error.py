@@ -33,6 +33,11 @@ from sections.speed import iterations, read_row
 
 CORIOLIS_OMEGA = 7.2921e-5
 RESOLUTION = {"impact": 1e-9, "drift": 1e-3}   # towing: the reference's standard error, relative
+# What the defaults must stay within, per problem: an impact's velocities to 1e-9 of the
+# approach speed (far below any measured restitution); a drift track to 1 m over 24 h (a
+# drifting buoy's or iceberg's GPS fix is good to some metres); the towing force within the
+# converged run's 95 % interval (1.96 standard errors): below that, a difference is noise.
+NOISE = {"impact": 1e-9, "drift": 1.0}
 
 
 def config(quick):
@@ -48,6 +53,8 @@ def config(quick):
 IMPACT = os.path.join("impacts", "floe_floe_headon.toml")
 IMPACT_DT = 0.0007955       # the scenario's step
 DRIFT = "free_drift_analytic.toml"
+DRIFT_DT = 60.0             # the scenario's step
+TOWING_DT = 0.1             # towing_paper.toml's step
 
 
 def pair(tag, scenario, engine, sets, window, meta, cost=0.2):
@@ -80,6 +87,16 @@ def plan(ctx):
             runs += pair(f"ce_towing_{e}_it{it}_dt{dt:g}", scenario, e,
                          base + [f"run.dt={dt!r}"] + iterations(e, it), t["window"],
                          dict(case="towing", iterations=it, dt=dt), cost=t["duration"] / dt * 1e-3)
+    # Native with its defaults at each problem's own step (the towing case's, the scenario's):
+    # what a user gets, drawn on each curve (docs/performance.md, "Why the defaults are what they are").
+    runs += pair("ce_impact_native_default", os.path.join(ctx.scenarios, IMPACT), "native", [], 0.1,
+                 dict(case="impact", iterations="defaults", dt=IMPACT_DT, default=True))
+    runs += pair("ce_drift_native_default", os.path.join(ctx.scenarios, DRIFT), "native",
+                 [f"run.dt={DRIFT_DT!r}", f"run.output_every={round(600.0 / DRIFT_DT)}"], 43200.0,
+                 dict(case="drift", iterations="defaults", dt=DRIFT_DT, default=True))
+    runs += pair("ce_towing_native_default", scenario, "native", base + [f"run.dt={TOWING_DT!r}"], t["window"],
+                 dict(case="towing", iterations="defaults", dt=TOWING_DT, default=True),
+                 cost=t["duration"] / TOWING_DT * 1e-3)
     dt, it = t["reference"]
     runs.append(Run("ce_towing_reference", scenario, "native",
                     base + [f"run.dt={dt!r}", f"engine.native.velocity_iterations={it}"],
@@ -136,6 +153,7 @@ def write(ctx):
     ref = next((r for r in ctx.all_runs if r.tag == "ce_towing_reference"), None)
     ref_mean, ref_se = towing_mean(ref.out, s_stat) if ref else (math.nan, math.nan)
     points = {}   # case -> engine -> [(error, cost ms per model s, label)]
+    defaults = {}  # case -> (error, cost, label, dt): native with its defaults
     refused = []
     for r in ctx.all_runs:
         if not r.tag.startswith("ce_") or r.meta.get("part") != "error":
@@ -153,6 +171,9 @@ def write(ctx):
             err = drift_error(r.out)
         else:
             err = abs(towing_mean(r.out, s_stat)[0] - ref_mean) / abs(ref_mean)
+        if r.meta.get("default"):
+            defaults[case] = (err, cost, f"defaults/{r.meta['dt']:.3g}s", r.meta["dt"])
+            continue
         label = f"{r.meta['iterations']}it/{r.meta['dt']:.3g}s" if r.meta["iterations"] else f"{r.meta['dt']:g}s"
         points.setdefault(case, {}).setdefault(r.engine, []).append((err, cost, label, r.meta["dt"]))
 
@@ -170,6 +191,9 @@ def write(ctx):
             ax.loglog([max(p[0], floor) for p in pts], [p[1] for p in pts], "o", label=e, alpha=0.8)
             for p in pts:
                 ax.annotate(p[2], (max(p[0], floor), p[1]), fontsize=6, alpha=0.6)
+        if case in defaults:
+            d = defaults[case]
+            ax.loglog([max(d[0], floor)], [d[1]], "*", ms=13, color="black", label="native defaults")
         if case == "towing" and ref_se == ref_se:
             ax.axvspan(floor, ref_se / abs(ref_mean), color="grey", alpha=0.15, lw=0)
         ax.set_xlabel(titles[case][0])
@@ -215,6 +239,16 @@ def write(ctx):
                 verdicts.append((case, e, n == len(pts)))
             md.append(f"| {case} | {e} | {len(pts)} | {beaten} | {best[0]:.3g} | {best[1]:.3g} |")
     md.append("")
+    if defaults:
+        # The defaults against each problem's noise (NOISE above).
+        noise = dict(NOISE, towing=1.96 * ref_se / abs(ref_mean) if ref_se == ref_se else math.nan)
+        md += ["Native with its defaults, at each problem's own step (the star on each panel), against each "
+               "problem's noise (impact 1e-9 of the approach speed; drift 1 m over 24 h, below a GPS fix; towing "
+               "the converged run's 95 % interval, 1.96 standard errors): " + "; ".join(
+            f"{case}, error {d[0]:.3g} (" + (f"{'within' if d[0] <= noise[case] else 'beyond'} its noise {noise[case]:.3g}"
+                                            if noise[case] == noise[case] else "no interval: too short a run") +
+            f") at {d[1]:.3g} ms per model s" for case, d in
+            ((c, defaults[c]) for c in ("impact", "drift", "towing") if c in defaults)) + ".", ""]
     if verdicts:
         below = [f"{c} vs {e}" for c, e, ok in verdicts if ok]
         not_below = [f"{c} vs {e}" for c, e, ok in verdicts if not ok]
