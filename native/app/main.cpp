@@ -141,6 +141,17 @@ struct CheckCommand {
     if (engines.empty()) engines.emplace_back("native");
     for (const std::string& e : engines) (void)floedem::make_engine(e, scene);
     std::cout << scenario << ": ok (" << scene.bodies.size() << " bodies, " << scene.run.steps() << " steps)\n";
+    // The forcing that changes in time, and how much of the run each record covers (a record
+    // that did not cover it was refused above).
+    const floedem::EnvironmentSpec& env = scene.environment;
+    for (const auto& [what, series] : {std::pair{"current", &env.current_series}, std::pair{"wind", &env.wind_series}})
+      if (!series->empty())
+        std::cout << "  " << what << " record " << series->file << ": " << series->time.size() << " samples over ["
+                  << series->time.front() << ", " << series->time.back() << "] s, the run [0, " << scene.run.duration
+                  << "] s\n";
+    for (const floedem::TidalConstituent& c : env.tides)
+      std::cout << "  tide " << (c.name.empty() ? "period " + std::to_string(c.period) + " s" : c.name) << ": major "
+                << c.major << " m/s, minor " << c.minor << " m/s\n";
     return 0;
   }
 };

@@ -8,7 +8,8 @@ namespace floedem {
 std::unique_ptr<ForceTerm> build_air_form_drag(const Scene& scene) {
   if (!scene.has_environment) return nullptr;
   const EnvironmentSpec& env = scene.environment;
-  auto term = std::make_unique<DistributedDrag>("air_form_drag", DistributedDrag::Kind::form, env);
+  auto term = std::make_unique<DistributedDrag>("air_form_drag", DistributedDrag::Kind::form, env,
+                                                DistributedDrag::Medium::air);
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& b = scene.bodies[i];
     if (b.fixed || b.drag.air_form == 0.0 || b.freeboard <= 0.0 || env.air_density == 0.0) continue;

@@ -113,8 +113,32 @@ void add_skin_drag(BodySum& sum, const std::vector<AreaPoint>& points, double sc
   }
 }
 
-DistributedDrag::DistributedDrag(std::string_view name, Kind kind, const EnvironmentSpec& environment)
-    : name_(name), kind_(kind), settings_{environment.rotational_damping, environment.drag_reference_speed} {}
+DistributedDrag::DistributedDrag(std::string_view name, Kind kind, const EnvironmentSpec& environment, Medium medium)
+    : name_(name),
+      kind_(kind),
+      settings_{environment.rotational_damping, environment.drag_reference_speed},
+      environment_(environment),
+      medium_(medium),
+      varies_(medium == Medium::water ? environment.current_varies() : environment.wind_varies()),
+      calm_(!varies_) {}
+
+void DistributedDrag::set_time(double time) {
+  if (!varies_) return;
+  const Vec2 change = medium_ == Medium::water ? environment_.current_change(time) : environment_.wind_change(time);
+  if (change.x == change_.x && change.y == change_.y) return;  // the flows hold it already
+  change_ = change;
+  // Every copy of a slab's flow: the slab's own, the rest test's, and its lane's (drag.hpp).
+  for (std::size_t k = 0; k < slabs_.size(); ++k) slabs_[k].drag.flow = given_flow_[k] + change;
+  for (std::size_t i = 0; i < entries_.size(); ++i)
+    if (entries_[i].slab_count > 0) quiet_[i].flow = slabs_[entries_[i].first_slab].drag.flow;
+  if (lanes_packed_)
+    for (LaneGroup& g : groups_)
+      for (std::uint32_t l = 0; l < g.lanes; ++l) {
+        const Vec2 flow = slabs_[entries_[g.entry[l]].first_slab].drag.flow;
+        g.flow_x[l] = flow.x;
+        g.flow_y[l] = flow.y;
+      }
+}
 
 void DistributedDrag::leave_to_pass(const std::vector<std::uint8_t>& shared) {
   passed_.assign(entries_.size(), 0);
@@ -159,6 +183,7 @@ void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_
       slab.count = static_cast<std::uint32_t>(skin_.size()) - slab.first;
     }
     slabs_.push_back(slab);
+    if (varies_) given_flow_.push_back(drag.flow);
   }
   // What the rest test reads, packed: one flow when every slab shares it (a floe's one slab).
   Quiet q{body, slabs.empty() ? Vec2{} : slabs.front().flow, true, slabs.size() == 1,

@@ -66,8 +66,17 @@ struct DragSlab {
 class DistributedDrag final : public ForceTerm {
  public:
   enum class Kind { form, skin };
-  DistributedDrag(std::string_view name, Kind kind, const EnvironmentSpec& environment);
+  /// What the slabs' flows are of: the current (water) or the wind (air).
+  enum class Medium { water, air };
+  DistributedDrag(std::string_view name, Kind kind, const EnvironmentSpec& environment, Medium medium);
   void add_body(std::size_t body, const std::vector<Vec2>& local_polygon, std::vector<DragSlab> slabs);
+  /// Whether the medium's flow changes in time (tides, a series: EnvironmentSpec::current_varies,
+  /// wind_varies); then every slab's flow is its flow as added plus the change the environment
+  /// gives at each step (set_time), the same at every slab: a tidal current or a wind record
+  /// is uniform over a scene.
+  bool flow_varies() const { return varies_; }
+  /// Sets every slab's flow for the step that starts at `time` (Forcing, before add).
+  void set_time(double time);
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return name_; }
   void add(const BodyStatesView& state, double time, ForceSums& sums) const override;
@@ -163,6 +172,11 @@ class DistributedDrag final : public ForceTerm {
   std::string_view name_;
   Kind kind_;
   DragSettings settings_;
+  const EnvironmentSpec& environment_;
+  Medium medium_;
+  bool varies_ = false;
+  std::vector<Vec2> given_flow_;  // per slab: its flow as added (varies_ only)
+  Vec2 change_;                   // the change the flows hold now (varies_ only)
   std::vector<Entry> entries_;
   std::vector<Slab> slabs_;
   std::vector<FormEdge> form_;
@@ -170,7 +184,7 @@ class DistributedDrag final : public ForceTerm {
   std::vector<Quiet> quiet_;  // per entry, what adds_nothing reads (kept apart: read every step)
   // Every slab's flow is zero (and the drag is not linearised skin drag, which acts at u = 0):
   // a body at rest adds exactly nothing (adds_nothing), so only moving bodies are visited.
-  bool calm_ = true;
+  bool calm_ = true;  // false from the start where the flow varies
   std::vector<std::int32_t> entry_of_body_;  // -1: the body has no entry
   // The lanes (pack_lanes), and per entry whether this step's add left it to them.
   mutable bool lanes_packed_ = false;

@@ -389,6 +389,20 @@ DragPass::DragPass(const std::vector<DistributedDrag*>& terms,
     for (std::size_t k = 0; k < groups_.size(); ++k) visit_.push_back(static_cast<std::uint32_t>(k));
 }
 
+void DragPass::refresh_flows() {
+  for (Group& g : groups_)
+    for (int t = 0; t < shape_.terms; ++t) {
+      const DistributedDrag& d = *terms_[static_cast<std::size_t>(t)];
+      if (!d.flow_varies()) continue;
+      const auto k = static_cast<std::size_t>(t);
+      for (std::uint32_t l = 0; l < g.lanes; ++l) {
+        const Vec2 flow = d.slabs_[d.entries_[g.entry[k][l]].first_slab].drag.flow;
+        g.flow_x[k][l] = flow.x;
+        g.flow_y[k][l] = flow.y;
+      }
+    }
+}
+
 std::span<const std::uint32_t> DragPass::groups_to_visit(const ForceSums& sums) const {
   // In still water and air (every term calm) a floe at rest adds exactly nothing in any term
   // (DistributedDrag::adds_nothing; the kernels add -0), so only the groups with a moving floe

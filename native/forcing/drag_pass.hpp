@@ -46,6 +46,9 @@ class DragPass {
   /// Adds the run's terms as they would add one after the other: each term its own bodies,
   /// then the shared floes in one pass.
   void add(const BodyStatesView& state, double time, ForceSums& sums) const;
+  /// Takes the terms' flows again into the groups, after a term whose flow varies set them
+  /// for a step (DistributedDrag::set_time).
+  void refresh_flows();
   /// The run's rate bounds (ForceTerm::add_rate_bound), likewise.
   void add_rate_bound(const BodyStatesView& state, ForceSums& sums) const;
 

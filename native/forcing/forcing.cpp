@@ -123,6 +123,8 @@ Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(
   sums_.rotation.resize(n);
   sums_.jacobian.assign(n, 1);
   sums_.rate_bound.resize(n);
+  for (auto& t : terms_)
+    if (DistributedDrag* d = t->distributed_drag(); d && d->flow_varies()) varying_.push_back(d);
   list_stirred_ = std::any_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->reads_stirred(); });
   moving_only_ = list_stirred_ && std::all_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->idle_at_rest(); });
   if (list_stirred_) sums_.stirred.reserve(n);
@@ -198,6 +200,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     }
     return &loads_;
   }
+  if (!varying_.empty()) set_flows(time);
   const BodyStatesView at = state_seen(state);
   place_rotations(at, rotations);
   sums_.stirred.clear();
@@ -253,6 +256,13 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
   loads_.listed = sparse;
   note_ahead();
   return &loads_;
+}
+
+void Forcing::set_flows(double time) {
+  // The flows at the step's start, t_n: the leapfrog takes its force there (the comment at the
+  // top), so a flow that changes in time keeps the step second order.
+  for (DistributedDrag* d : varying_) d->set_time(time);
+  if (drag_pass_) drag_pass_->refresh_flows();
 }
 
 BodyStatesView Forcing::state_seen(const BodyStates& state) {

@@ -68,6 +68,10 @@ class Forcing {
   void note_ahead();        ///< sets any_ahead_ from ahead_
 
   std::vector<std::unique_ptr<ForceTerm>> terms_;
+  /// The drag terms whose flow changes in time (tides, a series): their flows are set for each
+  /// step before the terms are asked for anything (DistributedDrag::set_time).
+  std::vector<DistributedDrag*> varying_;
+  void set_flows(double time);
   /// The run of consecutive drag terms terms_[pass_first_, pass_first_ + pass_count_) that
   /// shares one pass over the floes (drag_pass.hpp), or nullptr.
   std::unique_ptr<DragPass> drag_pass_;

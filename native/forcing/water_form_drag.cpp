@@ -9,7 +9,8 @@ namespace floedem {
 std::unique_ptr<ForceTerm> build_water_form_drag(const Scene& scene) {
   if (!scene.has_environment) return nullptr;
   const EnvironmentSpec& env = scene.environment;
-  auto term = std::make_unique<DistributedDrag>("water_form_drag", DistributedDrag::Kind::form, env);
+  auto term = std::make_unique<DistributedDrag>("water_form_drag", DistributedDrag::Kind::form, env,
+                                                DistributedDrag::Medium::water);
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& b = scene.bodies[i];
     if (b.fixed || b.drag.water_form == 0.0 || b.draft <= 0.0) continue;

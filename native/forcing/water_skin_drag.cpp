@@ -8,7 +8,8 @@ namespace floedem {
 std::unique_ptr<ForceTerm> build_water_skin_drag(const Scene& scene) {
   if (!scene.has_environment) return nullptr;
   const EnvironmentSpec& env = scene.environment;
-  auto term = std::make_unique<DistributedDrag>("water_skin_drag", DistributedDrag::Kind::skin, env);
+  auto term = std::make_unique<DistributedDrag>("water_skin_drag", DistributedDrag::Kind::skin, env,
+                                                DistributedDrag::Medium::water);
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& b = scene.bodies[i];
     if (b.fixed || b.drag.water_skin == 0.0) continue;

@@ -14,6 +14,7 @@
 #include "floedem/field/field_generator.hpp"
 #include "geometry/polygon.hpp"
 #include "floedem/io/output.hpp"
+#include "scenario/met_ocean_input.hpp"
 #include "scenario/table_reader.hpp"
 #include "floedem/scene/input_error.hpp"
 #include "collision/overlap.hpp"
@@ -112,6 +113,10 @@ void read_run(TableReader& root, Scene& scene) {
     r.fail("dt", "must not exceed run.duration; allowed (0, " + std::to_string(scene.run.duration) + "]");
   scene.run.output_every = static_cast<int>(r.integer("output_every", 1, 1, 1'000'000'000));
   scene.run.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
+  if (r.has("start")) {
+    scene.run.start_unix = read_utc_instant(r, "start");
+    scene.run.start = r.string("start", std::nullopt);
+  }
   r.reject_unknown();
 }
 
@@ -193,6 +198,12 @@ EnvironmentDefaults read_environment(TableReader& root, Scene& scene) {
     env.current = env.current_profile.front().velocity;
   }
   env.wind = r.vec2("wind", Vec2{});
+  if (r.has("current_file") && (r.has("current") || r.has("current_profile")))
+    r.fail("current_file", "give current, current_profile or current_file, one of them");
+  if (r.has("wind_file") && r.has("wind")) r.fail("wind_file", "give wind or wind_file, not both");
+  read_velocity_file(r, "current_file", scene, env.current_series);
+  read_velocity_file(r, "wind_file", scene, env.wind_series);
+  read_tides(r, scene);
   env.water_density = r.real("water_density", env.water_density, Range::positive());
   env.air_density = r.real("air_density", env.air_density, Range::non_negative());
   env.gravity = r.real("gravity", env.gravity, Range::non_negative());
@@ -204,7 +215,7 @@ EnvironmentDefaults read_environment(TableReader& root, Scene& scene) {
     env.latitude = degrees * M_PI / 180.0;
     env.coriolis_parameter = 2.0 * kEarthRotation * std::sin(env.latitude);
   }
-  const bool current_flows = env.current != Vec2{} || !env.current_profile.empty();
+  const bool current_flows = env.current != Vec2{} || !env.current_profile.empty() || env.current_varies();
   env.sea_surface_tilt = r.boolean("sea_surface_tilt", env.coriolis && current_flows);
   if (env.sea_surface_tilt && !env.coriolis)
     r.fail("sea_surface_tilt", "needs a latitude (the tilt balances the Coriolis force of the current)");

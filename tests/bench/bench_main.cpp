@@ -125,7 +125,9 @@ void BM_DragQuadrature(benchmark::State& state) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   EnvironmentSpec env;
-  DistributedDrag form("form", DistributedDrag::Kind::form, env), skin("skin", DistributedDrag::Kind::skin, env);
+  const auto water = DistributedDrag::Medium::water;
+  DistributedDrag form("form", DistributedDrag::Kind::form, env, water),
+      skin("skin", DistributedDrag::Kind::skin, env, water);
   std::vector<std::vector<EdgePoint>> edges;  // the rule's points, made once as the terms' were
   std::vector<std::vector<AreaPoint>> points;
   BodyStates s;
@@ -177,8 +179,10 @@ void BM_DragTerms(benchmark::State& state) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   EnvironmentSpec env;
   using Kind = DistributedDrag::Kind;
-  DistributedDrag water_form("water_form", Kind::form, env), water_skin("water_skin", Kind::skin, env),
-      air_form("air_form", Kind::form, env), air_skin("air_skin", Kind::skin, env);
+  using Medium = DistributedDrag::Medium;
+  DistributedDrag water_form("water_form", Kind::form, env, Medium::water),
+      water_skin("water_skin", Kind::skin, env, Medium::water), air_form("air_form", Kind::form, env, Medium::air),
+      air_skin("air_skin", Kind::skin, env, Medium::air);
   std::vector<std::vector<Vec2>> polys(n);
   BodyStates s;
   s.resize(n);

@@ -45,7 +45,7 @@ TEST_CASE("drag: the packed quadrature is the rule to the bit and the rate bound
           EnvironmentSpec env;
           env.rotational_damping = rotational;
           env.drag_reference_speed = reference_speed;
-          DistributedDrag drag("test", kind, env);
+          DistributedDrag drag("test", kind, env, DistributedDrag::Medium::water);
           // A random convex polygon about the origin (4 to 9 corners, 2 to 60 m).
           const int corners = 4 + trial % 6;
           const double size = 2.0 + 29.0 * (1.0 + u(rng));
@@ -112,7 +112,7 @@ TEST_CASE("drag: in still water only the moving bodies are visited, with the sum
   const std::vector<double> spin{0.0, 0.01, -0.02, 0.0, 0.0};
   for (const auto kind : {DistributedDrag::Kind::form, DistributedDrag::Kind::skin}) {
     EnvironmentSpec env;
-    DistributedDrag drag("still", kind, env);
+    DistributedDrag drag("still", kind, env, DistributedDrag::Medium::water);
     BodyStates s;
     s.resize(5);
     ForceSums sums = sums_for(5);
@@ -155,7 +155,7 @@ TEST_CASE("drag: in still water a few floes moving among many take their lane gr
   constexpr std::size_t n = 40;
   for (const auto kind : {DistributedDrag::Kind::form, DistributedDrag::Kind::skin}) {
     EnvironmentSpec env;
-    DistributedDrag drag("still", kind, env);
+    DistributedDrag drag("still", kind, env, DistributedDrag::Medium::water);
     BodyStates s;
     s.resize(n);
     for (std::size_t i = 0; i < n; ++i) drag.add_body(i, poly, {{400.0, 1.0, {0.0, 0.0}}});
@@ -317,7 +317,7 @@ TEST_CASE("drag: floes four at a time give each floe the rule's sums to the bit,
                       << (kind == DistributedDrag::Kind::form));
           EnvironmentSpec env;
           env.rotational_damping = rotational;
-          DistributedDrag drag("lanes", kind, env);
+          DistributedDrag drag("lanes", kind, env, DistributedDrag::Medium::water);
           std::vector<std::vector<Vec2>> polys(n);
           std::vector<std::vector<DragSlab>> slabs(n);
           for (std::size_t i = 0; i < n; ++i) {

@@ -73,10 +73,10 @@ TEST_CASE("drag pass: four drag terms in one pass give each body the terms' sums
           std::vector<DistributedDrag*> all() { return {&water_form, &water_skin, &air_form, &air_skin}; }
         };
         auto make = [&] {
-          auto t = std::make_unique<Terms>(Terms{DistributedDrag("water_form", Kind::form, env),
-                                                 DistributedDrag("water_skin", Kind::skin, env),
-                                                 DistributedDrag("air_form", Kind::form, env),
-                                                 DistributedDrag("air_skin", Kind::skin, env)});
+          auto t = std::make_unique<Terms>(Terms{DistributedDrag("water_form", Kind::form, env, DistributedDrag::Medium::water),
+                                                 DistributedDrag("water_skin", Kind::skin, env, DistributedDrag::Medium::water),
+                                                 DistributedDrag("air_form", Kind::form, env, DistributedDrag::Medium::air),
+                                                 DistributedDrag("air_skin", Kind::skin, env, DistributedDrag::Medium::air)});
           for (std::size_t i = 0; i < n; ++i) {
             t->water_form.add_body(i, polys[i], bodies[i].keel);
             t->water_skin.add_body(i, polys[i], bodies[i].water_skin);

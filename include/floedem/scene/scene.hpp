@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "floedem/geometry/vec2.hpp"
+#include "floedem/scene/met_ocean.hpp"
 
 namespace floedem {
 
@@ -18,6 +19,8 @@ struct RunSettings {
   double dt = 0.0;              ///< s, time step (required, > 0)
   int output_every = 1;         ///< steps between recorded frames (>= 1)
   std::uint64_t seed = 1;       ///< random seed for anything stochastic in the scene
+  std::string start;            ///< the instant t = 0 as given (ISO 8601, UTC), empty if not
+  double start_unix = 0.0;      ///< ... in s since 1970-01-01T00:00:00Z (0 where not given)
   /// Number of steps: duration / dt rounded to the nearest integer (at least 1).
   std::int64_t steps() const;
 };
@@ -124,9 +127,24 @@ struct EnvironmentSpec {
   double drag_reference_speed = 0.0;        ///< m/s; > 0: drag linearised, |u| replaced by this
   bool added_mass_in_contacts = false;      ///< true: contacts see m + m_a too
   bool water_drag = false, air_drag = false;///< which drag terms any body needs
+  // Forcing that changes in time (met_ocean.hpp, docs/forcing.md). A current series takes the
+  // place of `current` (which is then zero); the tides add to the current at every depth (a
+  // tidal current is barotropic: the same from surface to keel); a wind series takes the place
+  // of `wind`.
+  std::vector<TidalConstituent> tides;
+  VelocitySeries current_series, wind_series;
 
-  /// The current at a depth (m below the surface).
+  /// The current at a depth (m below the surface), without what changes in time.
   Vec2 current_at(double depth) const;
+  /// Whether the current or the wind changes in time.
+  bool current_varies() const { return !tides.empty() || !current_series.empty(); }
+  bool wind_varies() const { return !wind_series.empty(); }
+  /// What the current at time t (s) adds to current_at(depth) at every depth: the tides and
+  /// the current series; and its rate of change.
+  Vec2 current_change(double t) const;
+  Vec2 current_change_rate(double t) const;
+  /// What the wind at time t adds to `wind`: the wind series.
+  Vec2 wind_change(double t) const { return wind_series.empty() ? Vec2{} : wind_series.at(t); }
 };
 
 /// [tow]: an iceberg moved on a prescribed velocity, or pulled by a rope from a tug.

@@ -1,0 +1,46 @@
+#pragma once
+// Forcing that changes in time: tidal current ellipses and wind or current time series
+// (docs/forcing.md). Part of the engine-neutral scene: every engine is driven by the same
+// values, evaluated here once (one implementation of each law).
+#include <string>
+#include <vector>
+
+#include "floedem/geometry/vec2.hpp"
+
+namespace floedem {
+
+/// One tidal constituent as a current ellipse. With psi = 2 pi t / period - phase, the current
+/// as a complex number u + i v is
+///   U(t) = e^{i inclination} (major cos psi + i minor sin psi),
+/// the standard ellipse parameters of tidal current analysis (semi-major and semi-minor axis,
+/// the minor's sign giving the sense of rotation, inclination of the major axis from east, and
+/// phase; Foreman 1978, Pugh 1987 ch. 4), t counted from the run's start.
+struct TidalConstituent {
+  std::string name;          ///< "M2", ..., or empty where the period was given
+  double period = 0.0;       ///< s
+  double major = 0.0;        ///< m/s
+  double minor = 0.0;        ///< m/s, > 0 counter-clockwise
+  double inclination = 0.0;  ///< rad, of the major axis from +x, counter-clockwise
+  double phase = 0.0;        ///< rad
+  Vec2 velocity(double t) const;
+  Vec2 acceleration(double t) const;  ///< dU/dt
+};
+
+/// The period (s) of a standard constituent (M2, S2, N2, K2, K1, O1, P1, Q1), or 0 for a name
+/// that is not one.
+double tidal_period(const std::string& name);
+/// The standard names, in the order tidal_period knows them.
+const std::vector<std::string>& tidal_constituent_names();
+
+/// A velocity (m/s) against time (s from the run's start), linear between its samples: a wind
+/// or current record read from a CSV file (scenario.cpp checks that it covers the run).
+struct VelocitySeries {
+  std::string file;             ///< where it was read from, for messages and the output
+  std::vector<double> time;     ///< s, increasing
+  std::vector<Vec2> velocity;   ///< m/s
+  bool empty() const { return time.empty(); }
+  Vec2 at(double t) const;      ///< linear between samples; the end values past either end
+  Vec2 slope(double t) const;   ///< dV/dt of the segment holding t (the later one at a sample)
+};
+
+}  // namespace floedem
