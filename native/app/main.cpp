@@ -149,6 +149,14 @@ struct CheckCommand {
         std::cout << "  " << what << " record " << series->file << ": " << series->time.size() << " samples over ["
                   << series->time.front() << ", " << series->time.back() << "] s, the run [0, " << scene.run.duration
                   << "] s\n";
+    for (const auto& [what, grid] : {std::pair{"current", &env.current_grid}, std::pair{"wind", &env.wind_grid}})
+      if (!grid->empty())
+        std::cout << "  " << what << " grid " << grid->file << ": " << grid->u << ", " << grid->v << " on x ["
+                  << grid->x.front() << ", " << grid->x.back() << "] m (" << grid->x.size() << "), y [" << grid->y.front()
+                  << ", " << grid->y.back() << "] m (" << grid->y.size() << ")"
+                  << (grid->depth.empty() ? std::string() : ", " + std::to_string(grid->depth.size()) + " depths")
+                  << ", " << grid->time.size() << " times over [" << grid->time.front() << ", " << grid->time.back()
+                  << "] s, the run [0, " << scene.run.duration << "] s\n";
     for (const floedem::TidalConstituent& c : env.tides)
       std::cout << "  tide " << (c.name.empty() ? "period " + std::to_string(c.period) + " s" : c.name) << ": major "
                 << c.major << " m/s, minor " << c.minor << " m/s\n";

@@ -1,4 +1,5 @@
 #include "forcing/drag.hpp"
+#include "forcing/flow_grid.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -199,12 +200,18 @@ void DistributedDrag::add_body(std::size_t body, const std::vector<Vec2>& local_
 }
 
 void DistributedDrag::add_form_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const {
-  // add_form_drag, point by point in its order, each edge's normal turned once.
   const Vec2 flow = slab.drag.flow;
+  add_form_slab_at(sum, slab, v, w, rot, jacobian, [flow](Vec2) { return flow; });
+}
+
+template <class FlowAt>
+void DistributedDrag::add_form_slab_at(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian,
+                                       FlowAt flow_at) const {
+  // add_form_drag, point by point in its order, each edge's normal turned once.
   const DragSettings& s = settings_;
   auto point = [&](Vec2 local, Vec2 n, double k) {
     const Vec2 r = rot.apply(local);
-    const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
+    const Vec2 u = flow_at(r) - (s.rotational ? v + cross(w, r) : v);
     const double un = dot(u, n);
     if (un >= 0.0) return;  // the flow leaves this edge: no pressure on it
     add_form_point(sum, r, n, u, un, k, s, jacobian);
@@ -218,9 +225,15 @@ void DistributedDrag::add_form_slab(BodySum& sum, const Slab& slab, Vec2 v, doub
 }
 
 void DistributedDrag::add_skin_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const {
+  const Vec2 flow = slab.drag.flow;
+  add_skin_slab_at(sum, slab, v, w, rot, jacobian, [flow](Vec2) { return flow; });
+}
+
+template <class FlowAt>
+void DistributedDrag::add_skin_slab_at(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian,
+                                       FlowAt flow_at) const {
   // add_skin_drag, point by point in its order; the relative velocity and its magnitude at a
   // half-vertex serve both triangles that share it.
-  const Vec2 flow = slab.drag.flow;
   const DragSettings& s = settings_;
   struct Local {
     Vec2 r, u;
@@ -228,7 +241,7 @@ void DistributedDrag::add_skin_slab(BodySum& sum, const Slab& slab, Vec2 v, doub
   };
   auto at = [&](Vec2 local) {
     const Vec2 r = rot.apply(local);
-    const Vec2 u = flow - (s.rotational ? v + cross(w, r) : v);
+    const Vec2 u = flow_at(r) - (s.rotational ? v + cross(w, r) : v);
     return Local{r, u, s.reference_speed > 0.0 ? 0.0 : length(u)};
   };
   auto add = [&](const Local& p, double k) { add_skin_point(sum, p.r, p.u, p.m, k, s, jacobian); };
@@ -627,6 +640,22 @@ void DistributedDrag::for_entries(const ForceSums& sums, std::size_t grain, F&& 
 }
 
 bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) const {
+  if (grid_) {
+    // |u| <= |slab flow - v| + |grid's flow| + |w| |r|: the grid's largest speed bounds its part.
+    const double extra = grid_->max_speed();
+    thread_pool().for_blocks(entries_.size(), 2048, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const Entry& e = entries_[i];
+        const Vec2 v = s.velocity[e.body];
+        const double w = s.angular_velocity[e.body];
+        for (std::uint32_t k = 0; k < e.slab_count; ++k) {
+          const Slab& slab = slabs_[e.first_slab + k];
+          add_slab_bound(sums.rate_bound[e.body], slab.moments, slab.drag.flow, v, w, extra);
+        }
+      }
+    });
+    return true;
+  }
   if (!lanes_packed_) pack_lanes();
   if (!lanes_direct(sums)) {
     for_entries(sums, 2048, [&](std::size_t i) { add_entry_bound(i, s, sums); });
@@ -655,14 +684,14 @@ bool DistributedDrag::add_rate_bound(const BodyStatesView& s, ForceSums& sums) c
 }
 
 void DistributedDrag::add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& m, Vec2 flow, Vec2 v,
-                                     double w) const {
+                                     double w, double extra) const {
   constexpr double kRow = 1.0 + 1.4142135623730951;  // add_entry_bound says why
   if (settings_.reference_speed > 0.0) {
     b[0] += settings_.reference_speed * m[0];
     b[1] += settings_.rotational ? settings_.reference_speed * m[2] : 0.0;
     return;
   }
-  const double du = length(flow - v);
+  const double du = length(flow - v) + extra;
   const double spin = settings_.rotational ? std::abs(w) : 0.0;
   b[0] += kRow * (du * m[0] + spin * m[1]);
   b[1] += settings_.rotational ? 2.0 * (du * m[2] + spin * m[3]) : 0.0;
@@ -717,6 +746,16 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
   // Direct (lanes_direct: a moving flow, or many bodies moving): add_entry visits the entries
   // without a lane alone, and each group finds its own lanes to add, as add_entry would mark
   // them (the floe adds something and needs no Jacobian).
+  if (grid_) {  // a gridded medium: point by point, every entry (no lanes)
+    std::atomic<bool> any{false};
+    thread_pool().for_blocks(entries_.size(), 256, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        if (!passed(i) && add_entry_grid(i, s, sums) && !any.load(std::memory_order_relaxed))
+          any.store(true, std::memory_order_relaxed);
+    });
+    if (any.load(std::memory_order_relaxed)) sums.any_jacobian = true;
+    return;
+  }
   if (!lanes_packed_) pack_lanes();
   const bool direct = lanes_direct(sums);
   std::atomic<bool> any_jacobian{false};
@@ -772,6 +811,36 @@ void DistributedDrag::add(const BodyStatesView& s, double, ForceSums& sums) cons
     }
   });
   if (any_jacobian.load(std::memory_order_relaxed)) sums.any_jacobian = true;
+}
+
+void DistributedDrag::attach_fields(const FlowFields& fields) {
+  grid_ = medium_ == Medium::water ? fields.current.get() : fields.wind.get();
+}
+
+bool DistributedDrag::add_entry_grid(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {
+  const Entry& e = entries_[i];
+  const Vec2 v = s.velocity[e.body], x = s.position[e.body];
+  const double w = s.angular_velocity[e.body];
+  const bool jacobian = sums.jacobian[e.body] != 0;
+  const Rot rot = sums.rotation[e.body];
+  BodySum sum = sums.load(e.body);
+  for (std::uint32_t k = 0; k < e.slab_count; ++k) {
+    const Slab& slab = slabs_[e.first_slab + k];
+    // The slab's flow (the tides' change) plus the grid's at the point: 0 + V = V where the
+    // grid alone drives it. The cell of the body's centroid serves the points inside it (most
+    // floes lie within one cell); the others ask the grid.
+    const FlowGrid::Cell cell = grid_->cell(x, slab.drag.depth);
+    auto flow_at = [&](Vec2 r) {
+      const Vec2 p = x + r;
+      return slab.drag.flow + (cell.contains(p) ? cell.value(p) : grid_->at(p, slab.drag.depth));
+    };
+    if (kind_ == Kind::form)
+      add_form_slab_at(sum, slab, v, w, rot, jacobian, flow_at);
+    else
+      add_skin_slab_at(sum, slab, v, w, rot, jacobian, flow_at);
+  }
+  sums.store(e.body, sum);
+  return jacobian;
 }
 
 bool DistributedDrag::add_entry(std::size_t i, const BodyStatesView& s, ForceSums& sums) const {

@@ -59,6 +59,7 @@ struct DragSlab {
   double c = 0.0;
   double scale = 1.0;
   Vec2 flow;
+  double depth = 0.0;  ///< m below the surface where a gridded current is read (0 for the air)
 };
 
 /// A drag term distributed over the bodies' outlines (form) or areas (skin), slab by slab.
@@ -77,6 +78,11 @@ class DistributedDrag final : public ForceTerm {
   bool flow_varies() const { return varies_; }
   /// Sets every slab's flow for the step that starts at `time` (Forcing, before add).
   void set_time(double time);
+  /// Takes the scene's gridded fields (Forcing's, prepared each step): where the medium has
+  /// one, each quadrature point's flow is the grid's at the point (and its slab's depth) plus
+  /// the slab's flow; such a term has no lanes and no shared pass.
+  void attach_fields(const FlowFields& fields) override;
+  bool gridded() const { return grid_ != nullptr; }
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return name_; }
   void add(const BodyStatesView& state, double time, ForceSums& sums) const override;
@@ -119,6 +125,13 @@ class DistributedDrag final : public ForceTerm {
   };
   void add_form_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const;
   void add_skin_slab(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian) const;
+  /// The same with the flow of each point: flow_at(r), r the point's offset (world).
+  template <class FlowAt>
+  void add_form_slab_at(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian, FlowAt flow_at) const;
+  template <class FlowAt>
+  void add_skin_slab_at(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot, bool jacobian, FlowAt flow_at) const;
+  /// Entry i in a gridded medium: every slab point by point in the grid's flow.
+  bool add_entry_grid(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   /// The same without the Jacobian, for quadratic drag, two points at a time (drag.cpp).
   void add_form_slab_lean(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot) const;
   void add_skin_slab_lean(BodySum& sum, const Slab& slab, Vec2 v, double w, Rot rot) const;
@@ -128,8 +141,9 @@ class DistributedDrag final : public ForceTerm {
   bool add_entry(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   void add_entry_bound(std::size_t i, const BodyStatesView& state, ForceSums& sums) const;
   /// One slab's share of the rate bound (add_entry_bound's per-slab sum).
+  /// `extra`: a bound on the speed the grid adds to the slab's flow at any point (gridded).
   void add_slab_bound(std::array<double, 2>& b, const std::array<double, 4>& moments, Vec2 flow, Vec2 v,
-                      double w) const;
+                      double w, double extra = 0.0) const;
   /// Calls f(i) for each entry that may add something: every entry, or in still water and air
   /// (calm_) only those of the bodies that move (ForceSums::stirred), in blocks of `grain` on
   /// the pool's threads.
@@ -177,6 +191,7 @@ class DistributedDrag final : public ForceTerm {
   bool varies_ = false;
   std::vector<Vec2> given_flow_;  // per slab: its flow as added (varies_ only)
   Vec2 change_;                   // the change the flows hold now (varies_ only)
+  const FlowGrid* grid_ = nullptr;  // the medium's gridded field, if it has one
   std::vector<Entry> entries_;
   std::vector<Slab> slabs_;
   std::vector<FormEdge> form_;

@@ -19,6 +19,13 @@
 namespace floedem {
 
 class DistributedDrag;
+class FlowGrid;
+
+/// The scene's gridded wind and current (flow_grid.hpp), each null where the scene has none:
+/// built and prepared once a step by Forcing, read by the terms that take them.
+struct FlowFields {
+  std::unique_ptr<FlowGrid> current, wind;
+};
 
 /// One body's generalised force Q and Jacobian dQ/dq while a term adds to it point by point:
 /// a copy held in registers (the per-point sums would otherwise go through memory, since the
@@ -123,6 +130,9 @@ class ForceTerm {
   /// and spin at the state it sees) but, at most, a rotation rate: drag in still water and
   /// air, Coriolis. When every term is such, Forcing works on the moving bodies alone.
   virtual bool idle_at_rest() const { return false; }
+  /// Hands the term the scene's gridded fields (once, before the first step); a term that
+  /// reads none ignores them.
+  virtual void attach_fields(const FlowFields&) {}
   /// The term as a distributed drag (drag.hpp), which Forcing may hand a shared pass over the
   /// floes; nullptr for every other term.
   virtual DistributedDrag* distributed_drag() { return nullptr; }

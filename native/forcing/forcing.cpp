@@ -41,7 +41,9 @@
 #include <cmath>
 #include <limits>
 
+#include "floedem/scene/input_error.hpp"
 #include "forcing/drag_pass.hpp"
+#include "forcing/flow_grid.hpp"
 #include "forcing/forcing.hpp"
 #include "parallel/thread_pool.hpp"
 
@@ -92,6 +94,17 @@ double Forcing::drag_rate(const std::array<double, 9>& d, double mass, double in
 Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(scene.run.dt) {
   for (const ForceTermBuilder build : kTermBuilders)
     if (auto term = build(scene)) terms_.push_back(std::move(term));
+  // Gridded fields, read a time slice at a time (flow_grid.hpp), shared by the terms that read
+  // them; such drag terms work point by point, without the shared pass.
+  const EnvironmentSpec& env = scene.environment;
+  if (!env.current_grid.empty()) fields_.current = std::make_unique<FlowGrid>(env.current_grid);
+  if (!env.wind_grid.empty()) fields_.wind = std::make_unique<FlowGrid>(env.wind_grid);
+  bool gridded = false;
+  for (auto& t : terms_) {
+    t->attach_fields(fields_);
+    if (DistributedDrag* d = t->distributed_drag(); d && d->gridded()) gridded = true;
+  }
+  if (gridded) share_drag_pass = false;
   // The first run of consecutive drag terms (the four of a drifting field) shares a pass over
   // the floes they all act on; from then on those terms leave those floes to the pass.
   for (std::size_t k = 0; share_drag_pass && k < terms_.size(); ++k) {
@@ -235,6 +248,7 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
     }
     terms_[k]->add(at, time, sums_);
   }
+  if (fields_.current || fields_.wind) check_fields();
 
   const bool first_step = time == 0.0;
   // Per body, independent: blocks on the pool's threads (the same result on any number).
@@ -261,8 +275,20 @@ const Loads* Forcing::evaluate(const BodyStates& state, double time, std::span<c
 void Forcing::set_flows(double time) {
   // The flows at the step's start, t_n: the leapfrog takes its force there (the comment at the
   // top), so a flow that changes in time keeps the step second order.
+  for (FlowGrid* g : {fields_.current.get(), fields_.wind.get()})
+    if (g) g->prepare(time);
   for (DistributedDrag* d : varying_) d->set_time(time);
   if (drag_pass_) drag_pass_->refresh_flows();
+}
+
+void Forcing::check_fields() {
+  // A point off a grid or on its fill value was noted while the terms read it (from the pool's
+  // threads); the run stops here, between steps, with the file and what was found.
+  for (FlowGrid* g : {fields_.current.get(), fields_.wind.get()})
+    if (g)
+      if (const std::string problem = g->take_problem(); !problem.empty())
+        throw InputError(input_message(g->spec().file, 0, g->spec().u,
+                                       problem));
 }
 
 BodyStatesView Forcing::state_seen(const BodyStates& state) {

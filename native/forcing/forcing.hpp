@@ -71,7 +71,9 @@ class Forcing {
   /// The drag terms whose flow changes in time (tides, a series): their flows are set for each
   /// step before the terms are asked for anything (DistributedDrag::set_time).
   std::vector<DistributedDrag*> varying_;
+  FlowFields fields_;  // the scene's gridded wind and current (none: both null)
   void set_flows(double time);
+  void check_fields();  // InputError for a point off a grid or on its fill value
   /// The run of consecutive drag terms terms_[pass_first_, pass_first_ + pass_count_) that
   /// shares one pass over the floes (drag_pass.hpp), or nullptr.
   std::unique_ptr<DragPass> drag_pass_;

@@ -3,6 +3,7 @@
 // body's draft. A steady current gives F = m f k x V_w, computed once; a current that changes
 // in time (tides, a series: uniform over the scene and over depth) adds its change and its
 // rate at each step.
+#include "forcing/flow_grid.hpp"
 #include "forcing/force_term.hpp"
 
 namespace floedem {
@@ -17,7 +18,7 @@ class SeaSurfaceTilt final : public ForceTerm {
     for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
       const BodySpec& b = scene.bodies[i];
       if (b.fixed) continue;
-      const Vec2 v = draft_mean(b, env, nullptr);
+      const Vec2 v = draft_mean(b, env);
       const Vec2 f = (b.mass * env.coriolis_parameter) * cross(1.0, v);
       if (varies_ || f != Vec2{}) entries_.push_back({i, f, &b});
     }
@@ -25,37 +26,54 @@ class SeaSurfaceTilt final : public ForceTerm {
   bool empty() const { return entries_.empty(); }
   std::string_view name() const override { return "sea_surface_tilt"; }
   bool add_rate_bound(const BodyStatesView&, ForceSums&) const override { return true; }  // no Jacobian
-  void add(const BodyStatesView&, double time, ForceSums& sums) const override {
+  void add(const BodyStatesView& state, double time, ForceSums& sums) const override {
     if (!varies_) {
       for (const Entry& e : entries_) sums.add_force(e.body, e.force, 0.0);
       return;
     }
     const Vec2 change = environment_.current_change(time), rate = environment_.current_change_rate(time);
     for (const Entry& e : entries_) {
-      const Vec2 v = draft_mean(*e.spec, environment_, &change);
-      sums.add_force(e.body, (e.spec->mass * environment_.coriolis_parameter) * cross(1.0, v) + e.spec->mass * rate, 0.0);
+      Vec2 v, dv = rate;
+      if (grid_) {  // the grid's current at the body's centroid, over its draft
+        const Vec2 x = state.position[e.body];
+        v = draft_mean(*e.spec, environment_, [&](double depth) { return change + grid_->at(x, depth); });
+        // A grid without depth: its rate at the centroid as it is (a record's slope, to the bit).
+        dv = rate + (grid_->spec().depth.empty()
+                         ? grid_->rate_at(x, 0.0)
+                         : draft_mean(*e.spec, EnvironmentSpec{}, [&](double depth) { return grid_->rate_at(x, depth); }));
+      } else {
+        v = draft_mean(*e.spec, environment_, [&](double) { return change; });
+      }
+      sums.add_force(e.body, (e.spec->mass * environment_.coriolis_parameter) * cross(1.0, v) + e.spec->mass * dv, 0.0);
     }
   }
+  void attach_fields(const FlowFields& fields) override { grid_ = fields.current.get(); }
 
  private:
   /// The current averaged over the body's draft (16 samples a keel layer), plus `change` at
   /// every sample where given: sample by sample, so that a change added to a zero current
   /// gives the steady current's average to the bit (a steady series and a steady current
   /// then drive the same run). No draft: the surface current.
-  static Vec2 draft_mean(const BodySpec& b, const EnvironmentSpec& env, const Vec2* change) {
+  template <class Change>
+  static Vec2 draft_mean(const BodySpec& b, const EnvironmentSpec& env, Change change) {
     Vec2 mean;
     double total = 0.0;
     for (const KeelLayer& k : b.keel) {
       const int n = 16;
       for (int j = 0; j < n; ++j) {
         const double h = (k.bottom - k.top) / n;
-        const Vec2 c = env.current_at(k.top + (j + 0.5) * h);
-        mean += h * (change ? c + *change : c);
+        const double depth = k.top + (j + 0.5) * h;
+        mean += h * (env.current_at(depth) + change(depth));
         total += h;
       }
     }
     if (total > 0.0) return (1.0 / total) * mean;
-    return change ? env.current + *change : env.current;
+    return env.current + change(0.0);
+  }
+  /// The steady current's average: its samples plus +0 (x + 0 = x, and a sum that starts at
+  /// +0 takes -0 as +0, so the same average to the bit).
+  static Vec2 draft_mean(const BodySpec& b, const EnvironmentSpec& env) {
+    return draft_mean(b, env, [](double) { return Vec2{}; });
   }
   struct Entry {
     std::size_t body;
@@ -63,6 +81,7 @@ class SeaSurfaceTilt final : public ForceTerm {
     const BodySpec* spec;
   };
   const EnvironmentSpec& environment_;
+  const FlowGrid* grid_ = nullptr;
   bool varies_ = false;
   std::vector<Entry> entries_;
 };

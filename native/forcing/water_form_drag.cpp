@@ -23,7 +23,8 @@ std::unique_ptr<ForceTerm> build_water_form_drag(const Scene& scene) {
         if (c.depth > k.top && c.depth < k.bottom) cuts.push_back(c.depth);
       cuts.push_back(k.bottom);
       for (std::size_t j = 1; j < cuts.size(); ++j)
-        slabs.push_back({half_rho_c * (cuts[j] - cuts[j - 1]), k.width_scale, env.current_at(0.5 * (cuts[j] + cuts[j - 1]))});
+        slabs.push_back({half_rho_c * (cuts[j] - cuts[j - 1]), k.width_scale, env.current_at(0.5 * (cuts[j] + cuts[j - 1])),
+                         0.5 * (cuts[j] + cuts[j - 1])});
     }
     term->add_body(i, b.local_polygon, std::move(slabs));
   }

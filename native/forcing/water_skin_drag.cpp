@@ -15,7 +15,7 @@ std::unique_ptr<ForceTerm> build_water_skin_drag(const Scene& scene) {
     if (b.fixed || b.drag.water_skin == 0.0) continue;
     term->add_body(i, b.local_polygon,
                    {{env.water_density * b.drag.water_skin, b.keel.empty() ? 1.0 : b.keel.back().width_scale,
-                     env.current_at(b.draft)}});
+                     env.current_at(b.draft), b.draft}});
   }
   return if_used(std::move(term));
 }

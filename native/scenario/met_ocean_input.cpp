@@ -9,23 +9,12 @@
 #include <sstream>
 
 #include "floedem/scene/input_error.hpp"
+#include "io/netcdf_grid.hpp"
+#include "scene/calendar.hpp"
 
 namespace floedem {
 
 namespace {
-
-/// Days from 1970-01-01 to the civil date y-m-d (proleptic Gregorian): the era arithmetic of
-/// the 400-year cycle, March-based years so that the leap day ends a year.
-std::int64_t days_from_civil(std::int64_t y, int m, int d) {
-  y -= m <= 2 ? 1 : 0;
-  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
-  const std::int64_t yoe = y - era * 400;                               // [0, 399]
-  const std::int64_t doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;  // [0, 365]
-  const std::int64_t doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;      // [0, 146096]
-  return era * 146097 + doe - 719468;
-}
-
-bool leap(std::int64_t y) { return (y % 4 == 0 && y % 100 != 0) || y % 400 == 0; }
 
 std::string trim(const std::string& s) {
   const std::size_t a = s.find_first_not_of(" \t\r");
@@ -54,11 +43,8 @@ double read_utc_instant(TableReader& r, std::string_view key) {
   const std::string zone = text.substr(static_cast<std::size_t>(consumed));
   if (zone != "Z" && zone != "+00:00")
     r.fail(key, "'" + text + "' is not in UTC (it must end in Z); " + allowed);
-  static const int kDays[] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
-  if (mo < 1 || mo > 12 || d < 1 || d > kDays[mo - 1] + (mo == 2 && leap(y) ? 1 : 0) || h > 23 || mi > 59 ||
-      !(s >= 0.0 && s < 60.0))
-    r.fail(key, "'" + text + "' is not a valid date and time; " + allowed);
-  return static_cast<double>(days_from_civil(y, mo, d)) * 86400.0 + h * 3600.0 + mi * 60.0 + s;
+  if (!valid_instant(y, mo, d, h, mi, s)) r.fail(key, "'" + text + "' is not a valid date and time; " + allowed);
+  return unix_seconds(y, mo, d, h, mi, s);
 }
 
 void read_tides(TableReader& env, Scene& scene) {
@@ -88,7 +74,8 @@ void read_tides(TableReader& env, Scene& scene) {
   }
 }
 
-bool read_velocity_file(TableReader& env, std::string_view key, const Scene& scene, VelocitySeries& series) {
+bool read_velocity_file(TableReader& env, std::string_view key, const Scene& scene, VelocitySeries& series,
+                        FlowGridSpec& grid) {
   const toml::table* t = env.table(key);
   if (!t) return false;
   TableReader r(*t, scene.source_path, "environment." + std::string(key));
@@ -96,10 +83,15 @@ bool read_velocity_file(TableReader& env, std::string_view key, const Scene& sce
   const std::string u_name = r.string("u", "u"), v_name = r.string("v", "v");
   r.reject_unknown();
   const std::string extension = path.extension().string();
-  if (extension != ".csv")
-    r.fail("file", "'" + path.string() + "': allowed a time series in CSV (.csv)");
+  if (extension != ".csv" && extension != ".nc")
+    r.fail("file", "'" + path.string() + "': allowed a time series in CSV (.csv) or a grid in CF-NetCDF (.nc)");
   if (path.is_relative()) path = std::filesystem::path(scene.source_path).parent_path() / path;
   const std::string name = path.string();
+  if (extension == ".nc") {
+    if (!std::filesystem::is_regular_file(path)) r.fail("file", "cannot open '" + name + "': no such file");
+    grid = inspect_flow_grid(name, u_name, v_name, scene.run);
+    return true;
+  }
   std::ifstream in(name);
   if (!in) r.fail("file", "cannot open '" + name + "': " + std::strerror(errno));
   // A header naming the columns, then one sample a line; blank lines and lines from '#' are
@@ -165,6 +157,23 @@ bool read_velocity_file(TableReader& env, std::string_view key, const Scene& sce
                                    }() + " s (run.duration: the series must cover the run)"));
   }
   return true;
+}
+
+void check_grid_coverage(const Scene& scene) {
+  for (const FlowGridSpec* g : {&scene.environment.current_grid, &scene.environment.wind_grid}) {
+    if (g->empty()) continue;
+    for (const BodySpec& b : scene.bodies) {
+      if (b.fixed) continue;
+      for (const Vec2 p : b.polygon)
+        if (!(p.x >= g->x.front() && p.x <= g->x.back() && p.y >= g->y.front() && p.y <= g->y.back())) {
+          std::ostringstream o;
+          o << "body '" << b.name << "' at (" << p.x << ", " << p.y << ") m is off the grid, x [" << g->x.front() << ", "
+            << g->x.back() << "], y [" << g->y.front() << ", " << g->y.back()
+            << "] m; allowed a grid that holds every body";
+          throw InputError(input_message(g->file, 0, g->u, o.str()));
+        }
+    }
+  }
 }
 
 }  // namespace floedem

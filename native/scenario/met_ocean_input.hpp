@@ -17,8 +17,13 @@ void read_tides(TableReader& env_reader, Scene& scene);
 
 /// The table `key` ("current_file" or "wind_file") of `env_reader`, when present, read into
 /// `series`: a CSV file with a column `time` (s from the run's start) and the velocity's x and
-/// y columns (named by the table's u and v, default "u" and "v"), covering [0, run.duration].
-/// Returns whether the table was there.
-bool read_velocity_file(TableReader& env_reader, std::string_view key, const Scene& scene, VelocitySeries& series);
+/// y columns (named by the table's u and v, default "u" and "v"), covering [0, run.duration];
+/// or into `grid`, a CF-NetCDF file's axes (io/netcdf_grid.hpp). Returns whether the table
+/// was there.
+bool read_velocity_file(TableReader& env_reader, std::string_view key, const Scene& scene, VelocitySeries& series,
+                        FlowGridSpec& grid);
+
+/// InputError when a grid of the scene does not hold every body's outline at t = 0.
+void check_grid_coverage(const Scene& scene);
 
 }  // namespace floedem

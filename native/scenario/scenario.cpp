@@ -201,8 +201,8 @@ EnvironmentDefaults read_environment(TableReader& root, Scene& scene) {
   if (r.has("current_file") && (r.has("current") || r.has("current_profile")))
     r.fail("current_file", "give current, current_profile or current_file, one of them");
   if (r.has("wind_file") && r.has("wind")) r.fail("wind_file", "give wind or wind_file, not both");
-  read_velocity_file(r, "current_file", scene, env.current_series);
-  read_velocity_file(r, "wind_file", scene, env.wind_series);
+  read_velocity_file(r, "current_file", scene, env.current_series, env.current_grid);
+  read_velocity_file(r, "wind_file", scene, env.wind_series, env.wind_grid);
   read_tides(r, scene);
   env.water_density = r.real("water_density", env.water_density, Range::positive());
   env.air_density = r.real("air_density", env.air_density, Range::non_negative());
@@ -510,6 +510,7 @@ Scene parse_scenario(const std::string& text, const std::string& path, const std
   read_bodies(root, scene, defaults.ice_density, defaults.floe, defaults.iceberg);
   read_field(root, scene, defaults.ice_density, defaults.floe);
   read_output(root, scene);  // after the bodies: [output] loads names them
+  check_grid_coverage(scene);
   if (scene.bodies.empty()) root.fail("body", "no [[body]] and no [field] given; allowed at least one body");
   read_tow(root, scene);
   read_engines(root, scene);

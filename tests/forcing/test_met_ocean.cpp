@@ -6,10 +6,14 @@
 // and for W(t) linear on each segment is taken segment by segment, exactly.
 #include <catch2/catch.hpp>
 
+#include <netcdf.h>
+
 #include <complex>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
+#include "forcing/forcing.hpp"
 #include "run/stepper.hpp"
 #include "floedem/scenario/scenario.hpp"
 #include "floedem/scene/input_error.hpp"
@@ -63,6 +67,28 @@ std::string tide_toml(const std::vector<Tide>& tides) {
     o << "[[environment.tide]]\nperiod = " << t.period << "\nmajor = " << t.major << "\nminor = " << t.minor
       << "\ninclination = " << t.inclination_deg << "\nphase = " << t.phase_deg << "\n";
   return o.str();
+}
+
+struct Bad {
+  const char* what;
+  std::string text;
+  std::vector<std::string> expect;  // substrings of the message
+};
+
+/// Each case refused with one line that holds every expected part.
+void check_refusals(const std::vector<Bad>& cases) {
+  for (const Bad& c : cases) {
+    std::string message;
+    try {
+      test::scene_from(c.text);
+    } catch (const InputError& e) {
+      message = e.what();
+    }
+    INFO(c.what << ": " << message);
+    CHECK(!message.empty());
+    CHECK(message.find('\n') == std::string::npos);
+    for (const std::string& s : c.expect) CHECK(message.find(s) != std::string::npos);
+  }
 }
 
 }  // namespace
@@ -224,11 +250,6 @@ TEST_CASE("bad met-ocean input is refused with the file, the field and what is a
   auto with_current_file = [&](const std::string& path, const std::string& more = "") {
     return run + "[environment]\n" + more + "[environment.current_file]\nfile = \"" + path + "\"\n" + body;
   };
-  struct Bad {
-    const char* what;
-    std::string text;
-    std::vector<std::string> expect;
-  };
   const std::vector<Bad> cases = {
       {"missing file", with_current_file((dir / "none.csv").string()), {"'environment.current_file.file'", "cannot open"}},
       {"not csv", with_current_file("ocean.txt"), {"'environment.current_file.file'", "allowed", ".csv"}},
@@ -254,17 +275,7 @@ TEST_CASE("bad met-ocean input is refused with the file, the field and what is a
       {"start no date", "[run]\nduration = 1.0\ndt = 0.1\nstart = \"2024-02-30T00:00:00Z\"\n" + body,
        {"'run.start'", "not a valid date"}},
   };
-  for (const Bad& c : cases) {
-    std::string message;
-    try {
-      test::scene_from(c.text);
-    } catch (const InputError& e) {
-      message = e.what();
-    }
-    INFO(c.what << ": " << message);
-    CHECK(message.find('\n') == std::string::npos);
-    for (const std::string& s : c.expect) CHECK(message.find(s) != std::string::npos);
-  }
+  check_refusals(cases);
 }
 
 TEST_CASE("run.start is read as UTC seconds since 1970", "[input][met_ocean]") {
@@ -272,4 +283,268 @@ TEST_CASE("run.start is read as UTC seconds since 1970", "[input][met_ocean]") {
   const Scene s = test::scene_from("[run]\nduration = 1.0\ndt = 0.1\nstart = \"2024-03-01T06:30:00Z\"\n" + body);
   CHECK(s.run.start_unix == 1709274600.0);  // date -u -d 2024-03-01T06:30:00Z +%s
   CHECK(s.run.start == "2024-03-01T06:30:00Z");
+}
+
+// ---- Gridded fields (CF-NetCDF) --------------------------------------------------------------
+
+namespace {
+
+struct GridFile {
+  std::vector<double> x, y, time;  // m, m, hours since 2024-03-01
+  std::vector<double> depth;       // m; empty: (time, y, x)
+  std::function<Vec2(double t, double x, double y, double depth)> field;
+  std::string velocity_units = "m s-1", x_units = "m", time_units = "hours since 2024-03-01 00:00:00";
+  bool fill_somewhere = false;  // the first cell of every slice holds the fill value
+};
+
+void write_grid(const std::filesystem::path& path, const GridFile& g) {
+  int nc = -1;
+  REQUIRE(nc_create(path.c_str(), NC_CLOBBER | NC_NETCDF4, &nc) == NC_NOERR);
+  auto dim = [&](const char* name, const std::vector<double>& values, const std::string& units) {
+    int d = -1, v = -1;
+    nc_def_dim(nc, name, values.size(), &d);
+    nc_def_var(nc, name, NC_DOUBLE, 1, &d, &v);
+    nc_put_att_text(nc, v, "units", units.size(), units.c_str());
+    return std::pair{d, v};
+  };
+  const auto t = dim("time", g.time, g.time_units);
+  const bool z = !g.depth.empty();
+  const auto d = z ? dim("depth", g.depth, "m") : std::pair{-1, -1};
+  const auto y = dim("y", g.y, g.x_units);
+  const auto x = dim("x", g.x, g.x_units);
+  std::vector<int> dims = {t.first};
+  if (z) dims.push_back(d.first);
+  dims.push_back(y.first);
+  dims.push_back(x.first);
+  int u = -1, v = -1;
+  nc_def_var(nc, "uo", NC_FLOAT, static_cast<int>(dims.size()), dims.data(), &u);
+  nc_def_var(nc, "vo", NC_FLOAT, static_cast<int>(dims.size()), dims.data(), &v);
+  const float fill = -999.0f;
+  for (int var : {u, v}) {
+    nc_put_att_text(nc, var, "units", g.velocity_units.size(), g.velocity_units.c_str());
+    nc_put_att_float(nc, var, "_FillValue", NC_FLOAT, 1, &fill);
+  }
+  nc_enddef(nc);
+  nc_put_var_double(nc, t.second, g.time.data());
+  if (z) nc_put_var_double(nc, d.second, g.depth.data());
+  nc_put_var_double(nc, y.second, g.y.data());
+  nc_put_var_double(nc, x.second, g.x.data());
+  std::vector<float> us, vs;
+  const std::vector<double> levels = z ? g.depth : std::vector<double>{0.0};
+  for (double time : g.time)
+    for (double depth : levels)
+      for (double yy : g.y)
+        for (double xx : g.x) {
+          const Vec2 w = g.field(time * 3600.0, xx, yy, depth);
+          const bool hole = g.fill_somewhere && us.size() % (g.x.size() * g.y.size() * levels.size()) == 0;
+          us.push_back(hole ? fill : static_cast<float>(w.x));
+          vs.push_back(hole ? fill : static_cast<float>(w.y));
+        }
+  nc_put_var_float(nc, u, us.data());
+  nc_put_var_float(nc, v, vs.data());
+  REQUIRE(nc_close(nc) == NC_NOERR);
+}
+
+std::string grid_table(const std::filesystem::path& path) {
+  return "[environment.current_file]\nfile = \"" + path.string() + "\"\nu = \"uo\"\nv = \"vo\"\n";
+}
+
+const char* kStart = "[run]\nstart = \"2024-03-01T00:00:00Z\"\n";
+
+}  // namespace
+
+TEST_CASE("a gridded current constant in space and time gives the steady run to the bit", "[environment][met_ocean]") {
+  // Values a float holds exactly, so that the file's single precision changes nothing.
+  const std::filesystem::path dir = test::temp_dir("grid-steady");
+  GridFile g;
+  g.x = {-2000.0, 0.0, 5000.0};
+  g.y = {-3000.0, 3000.0};
+  g.time = {-1.0, 0.5, 2.0};
+  g.field = [](double, double, double, double) { return Vec2{0.25, -0.125}; };
+  write_grid(dir / "ocean.nc", g);
+  auto floes = [] {
+    std::string b;
+    const Vec2 at[] = {{0, 0}, {30, 2}, {60, -3}};
+    const Vec2 v[] = {{0.5, 0.0}, {-0.2, 0.0}, {0.0, 0.1}};
+    for (int k = 0; k < 3; ++k)
+      b += "[[body]]\nname = \"f" + std::to_string(k) + "\"\npolygon = " + test::toml_polygon(test::box(at[k], 20, 16, 0.2)) +
+           "\nthickness = 1.5\nvelocity = " + test::vec_toml(v[k]) + "\n";
+    return b;
+  };
+  const std::string head = std::string(kStart) + "duration = 3600.0\ndt = 0.5\n[environment]\nlatitude = 75.0\nwind = [6.0, 2.0]\n";
+  const Scene steady = test::scene_from(head + "current = [0.25, -0.125]\n" + floes());
+  const Scene gridded = test::scene_from(head + grid_table(dir / "ocean.nc") + floes());
+  REQUIRE(gridded.environment.current_grid.time.size() == 3);
+  CHECK(gridded.environment.current_grid.time.front() == -3600.0);
+  Stepper a(steady, "native"), b(gridded, "native");
+  bool touched = false;
+  for (std::int64_t k = 0; k < steady.run.steps(); ++k) {
+    a.step();
+    b.step();
+    touched = touched || !a.engine().contacts().empty();
+  }
+  CHECK(touched);
+  for (std::size_t i = 0; i < 3; ++i) {
+    CHECK(a.state().position[i].x == b.state().position[i].x);
+    CHECK(a.state().position[i].y == b.state().position[i].y);
+    CHECK(a.state().angle[i] == b.state().angle[i]);
+  }
+}
+
+TEST_CASE("a gridded current with a linear shear gives the analytic force and torque", "[environment][met_ocean]") {
+  // V = (0, s x) across a square floe of side L at x0, at rest, under linearised skin drag
+  // (k = rho_w C_dw U_ref per unit area): F_y = k s x0 L^2 and, about the centroid,
+  // tau = k \int (x - x0) s x dA = k s L^4 / 12. Bilinear interpolation holds a linear field
+  // exactly, and the skin drag's quadrature is exact for it.
+  const std::filesystem::path dir = test::temp_dir("grid-shear");
+  const double s = 1.0 / 8192.0, x0 = 150.0, L = 40.0;  // the grid's values (+-0.125 m/s) exact in a float
+  GridFile g;
+  g.x = {-1024.0, 0.0, 1024.0};
+  g.y = {-1024.0, 1024.0};
+  g.time = {0.0, 1.0};
+  g.field = [&](double, double x, double, double) { return Vec2{0.0, s * x}; };
+  write_grid(dir / "shear.nc", g);
+  const Scene sc = test::scene_from(
+      std::string(kStart) + "duration = 10.0\ndt = 1.0\n[environment]\ndrag_reference_speed = 0.1\n" +
+      grid_table(dir / "shear.nc") +
+      "[environment.drag]\nwater_form = 0.0\nwater_skin = 0.005\nair_form = 0.0\nair_skin = 0.0\n[[body]]\nname = \"f\"\n"
+      "polygon = " + test::toml_polygon(test::box({x0, 0.0}, L, L)) + "\nthickness = 1.0\n");
+  Forcing forcing(sc);
+  BodyStates st;
+  st.resize(1);
+  st.position[0] = sc.bodies[0].centroid;
+  forcing.evaluate(st, 0.0);
+  const double k = 1025.0 * 0.005 * 0.1;
+  const std::array<double, 3> q = forcing.environment_force(0);
+  CHECK(q[0] == Approx(0.0).margin(1e-9));
+  CHECK(q[1] == Approx(k * s * x0 * L * L).epsilon(1e-12));
+  CHECK(q[2] == Approx(k * s * std::pow(L, 4) / 12.0).epsilon(1e-12));
+}
+
+TEST_CASE("a gridded current that changes in time follows the record it samples", "[environment][met_ocean]") {
+  // The current record of the closed-form test above as a grid uniform in space, sampled every
+  // 3 h: the same velocities at every step, so the same drift to the bit as the CSV record, and
+  // so the same second-order convergence to the closed form.
+  const std::filesystem::path dir = test::temp_dir("grid-time");
+  GridFile g;
+  g.x = {-1e5, 1e5};
+  g.y = {-1e5, 1e5};
+  std::ofstream csv(dir / "current.csv");
+  csv.precision(17);
+  csv << "time,u,v\n";
+  for (int k = 0; k <= 8; ++k) {
+    g.time.push_back(3.0 * k);
+    // floats, so that the file holds the CSV's numbers exactly
+    const float u = static_cast<float>(0.15 + 0.2 * std::cos(0.7 * k)), v = static_cast<float>(0.05 - 0.1 * std::sin(1.3 * k));
+    csv << 10800.0 * k << ',' << static_cast<double>(u) << ',' << static_cast<double>(v) << '\n';
+  }
+  csv.close();
+  g.field = [](double t, double, double, double) {
+    const int k = static_cast<int>(std::lround(t / 10800.0));
+    return Vec2{static_cast<float>(0.15 + 0.2 * std::cos(0.7 * k)), static_cast<float>(0.05 - 0.1 * std::sin(1.3 * k))};
+  };
+  write_grid(dir / "ocean.nc", g);
+  const Scene by_csv = test::scene_from(
+      std::string(kStart) +
+      drift_scene(60.0, "", "[environment.current_file]\nfile = \"" + (dir / "current.csv").string() + "\"\n").substr(6));
+  const Scene by_grid = test::scene_from(std::string(kStart) + drift_scene(60.0, "", grid_table(dir / "ocean.nc")).substr(6));
+  Stepper a(by_csv, "native"), b(by_grid, "native");
+  for (std::int64_t k = 0; k < by_csv.run.steps(); ++k) {
+    a.step();
+    b.step();
+  }
+  CHECK(a.state().position[0].x == b.state().position[0].x);
+  CHECK(a.state().position[0].y == b.state().position[0].y);
+}
+
+TEST_CASE("bad gridded forcing is refused with the file, the variable and what is allowed", "[input][met_ocean]") {
+  const std::filesystem::path dir = test::temp_dir("grid-bad");
+  auto base = [] {
+    GridFile g;
+    g.x = {-100.0, 100.0};
+    g.y = {-100.0, 100.0};
+    g.time = {0.0, 1.0};
+    g.field = [](double, double, double, double) { return Vec2{0.1, 0.0}; };
+    return g;
+  };
+  const std::string body = "[[body]]\nname = \"a\"\npolygon = [[0,0],[10,0],[10,10],[0,10]]\nthickness = 1.0\n";
+  auto scene = [&](const std::string& file, const std::string& run = "") {
+    return std::string(run.empty() ? kStart : run.c_str()) + "duration = 3600.0\ndt = 1.0\n[environment]\n" +
+           grid_table(dir / file) + body;
+  };
+  std::vector<Bad> cases;
+  {
+    write_grid(dir / "ok.nc", base());
+    cases.push_back({"no run.start", scene("ok.nc", "[run]\n"), {"ok.nc", "'time'", "[run] start"}});
+    cases.push_back({"missing variable",
+                     std::string(kStart) + "duration = 3600.0\ndt = 1.0\n[environment]\n[environment.current_file]\nfile = \"" +
+                         (dir / "ok.nc").string() + "\"\nu = \"uu\"\nv = \"vo\"\n" + body,
+                     {"ok.nc", "'uu'", "no such variable"}});
+    GridFile g = base();
+    g.velocity_units = "cm/s";
+    write_grid(dir / "units.nc", g);
+    cases.push_back({"not a velocity", scene("units.nc"), {"units.nc", "'uo.units'", "'cm/s'", "m s-1"}});
+    g = base();
+    g.time = {0.0, 0.5};
+    write_grid(dir / "short.nc", g);
+    cases.push_back({"time not covering", scene("short.nc"), {"short.nc", "'time'", "covers [0, 1800]", ">= 3600"}});
+    g = base();
+    g.x = {20.0, 100.0};
+    write_grid(dir / "small.nc", g);
+    cases.push_back({"grid not covering", scene("small.nc"), {"small.nc", "'uo'", "body 'a'", "off the grid"}});
+    g = base();
+    g.x_units = "degrees_east";
+    write_grid(dir / "geo.nc", g);
+    cases.push_back({"longitude", scene("geo.nc"), {"geo.nc", "'x.units'", "geographic"}});
+    std::ofstream(dir / "text.nc") << "not netcdf\n";
+    cases.push_back({"not netcdf", scene("text.nc"), {"text.nc", "'file'", "cannot open as NetCDF"}});
+  }
+  check_refusals(cases);
+  // A fill value where a body is: found while stepping, the step refused with the file.
+  GridFile g = base();
+  g.x = {0.0, 100.0};
+  g.y = {0.0, 100.0};
+  g.fill_somewhere = true;
+  write_grid(dir / "hole.nc", g);
+  const Scene s = test::scene_from(scene("hole.nc"));
+  Stepper run(s, "native");
+  std::string message;
+  try {
+    run.step();
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  INFO(message);
+  CHECK(message.find("hole.nc") != std::string::npos);
+  CHECK(message.find("fill value") != std::string::npos);
+}
+
+TEST_CASE("a gridded current with a depth axis feeds each keel layer the current at its depth",
+          "[environment][met_ocean]") {
+  // u = d / 100 m/s at depth d (levels at 0 and 100 m), read linearly in depth: the keel's one
+  // layer, 0 to 60 m, reads it at its middle, 30 m: 0.3 m/s, the force of a steady 0.3 m/s
+  // current on that layer to the bit (form drag alone).
+  const std::filesystem::path dir = test::temp_dir("grid-depth");
+  GridFile g;
+  g.x = {-500.0, 500.0};
+  g.y = {-500.0, 500.0};
+  g.depth = {0.0, 100.0};
+  g.time = {0.0, 1.0};
+  g.field = [](double, double, double, double depth) { return Vec2{depth / 100.0, 0.0}; };
+  write_grid(dir / "layers.nc", g);
+  const std::string berg =
+      "[environment.drag]\nwater_skin = 0.0\nair_form = 0.0\nair_skin = 0.0\n[[body]]\nname = \"berg\"\nkind = \"iceberg\"\n"
+      "polygon = [[0,0],[100,0],[100,50],[0,50]]\ndraft = 60\nsail_height = 10\nmass = 2e8\n";
+  const std::string head = std::string(kStart) + "duration = 10.0\ndt = 1.0\n[environment]\n";
+  const Scene gridded = test::scene_from(head + grid_table(dir / "layers.nc") + berg);
+  const Scene steady = test::scene_from(head + "current = [0.3, 0.0]\n" + berg);
+  REQUIRE(gridded.environment.current_grid.depth.size() == 2);
+  Forcing a(gridded), b(steady);
+  BodyStates st;
+  st.resize(1);
+  st.position[0] = gridded.bodies[0].centroid;
+  a.evaluate(st, 0.0);
+  b.evaluate(st, 0.0);
+  CHECK(a.environment_force(0)[0] > 0.0);
+  CHECK(a.environment_force(0) == b.environment_force(0));
 }

@@ -43,4 +43,16 @@ struct VelocitySeries {
   Vec2 slope(double t) const;   ///< dV/dt of the segment holding t (the later one at a sample)
 };
 
+/// A velocity field on a grid that varies in space and time, as a CF-NetCDF file holds it
+/// (docs/forcing.md): its axes, read and checked when the scenario is loaded; the run reads
+/// the values a time slice at a time.
+struct FlowGridSpec {
+  std::string file;            ///< the file, as found from the scenario's folder
+  std::string u, v;            ///< its variables of the x (east) and y (north) components
+  std::vector<double> x, y;    ///< m, the scene's axes, increasing
+  std::vector<double> depth;   ///< m below the surface, increasing; empty: no depth axis
+  std::vector<double> time;    ///< s from the run's start, increasing
+  bool empty() const { return file.empty(); }
+};
+
 }  // namespace floedem

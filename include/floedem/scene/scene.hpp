@@ -133,14 +133,17 @@ struct EnvironmentSpec {
   // of `wind`.
   std::vector<TidalConstituent> tides;
   VelocitySeries current_series, wind_series;
+  /// A current or wind on a grid (a CF-NetCDF file): it takes the place of the steady current
+  /// (or wind) at each point of each body; the tides add to it.
+  FlowGridSpec current_grid, wind_grid;
 
   /// The current at a depth (m below the surface), without what changes in time.
   Vec2 current_at(double depth) const;
   /// Whether the current or the wind changes in time.
-  bool current_varies() const { return !tides.empty() || !current_series.empty(); }
-  bool wind_varies() const { return !wind_series.empty(); }
-  /// What the current at time t (s) adds to current_at(depth) at every depth: the tides and
-  /// the current series; and its rate of change.
+  bool current_varies() const { return !tides.empty() || !current_series.empty() || !current_grid.empty(); }
+  bool wind_varies() const { return !wind_series.empty() || !wind_grid.empty(); }
+  /// What the current at time t (s) adds to current_at(depth) at every depth and every point:
+  /// the tides and the current series (not a grid's field); and its rate of change.
   Vec2 current_change(double t) const;
   Vec2 current_change_rate(double t) const;
   /// What the wind at time t adds to `wind`: the wind series.
