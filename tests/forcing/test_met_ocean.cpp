@@ -69,6 +69,17 @@ std::string tide_toml(const std::vector<Tide>& tides) {
   return o.str();
 }
 
+/// Three floes that close on each other (a collision within the first minutes).
+std::string three_floes() {
+  std::string b;
+  const Vec2 at[] = {{0, 0}, {30, 2}, {60, -3}};
+  const Vec2 v[] = {{0.5, 0.0}, {-0.2, 0.0}, {0.0, 0.1}};
+  for (int k = 0; k < 3; ++k)
+    b += "[[body]]\nname = \"f" + std::to_string(k) + "\"\npolygon = " + test::toml_polygon(test::box(at[k], 20, 16, 0.2)) +
+         "\nthickness = 1.5\nvelocity = " + test::vec_toml(v[k]) + "\n";
+  return b;
+}
+
 struct Bad {
   const char* what;
   std::string text;
@@ -183,20 +194,11 @@ TEST_CASE("a steady series gives the steady run to the bit, drag, tilt and conta
     std::ofstream(dir / "current.csv") << "time,u,v\n0,0.3,-0.1\n7200,0.3,-0.1\n";
     std::ofstream(dir / "wind.csv") << "time,east,north\n-10,8.0,3.0\n7200,8.0,3.0\n";
   }
-  auto floes = [] {
-    std::string b;
-    const Vec2 at[] = {{0, 0}, {30, 2}, {60, -3}};
-    const Vec2 v[] = {{0.5, 0.0}, {-0.2, 0.0}, {0.0, 0.1}};
-    for (int k = 0; k < 3; ++k)
-      b += "[[body]]\nname = \"f" + std::to_string(k) + "\"\npolygon = " + test::toml_polygon(test::box(at[k], 20, 16, 0.2)) +
-           "\nthickness = 1.5\nvelocity = " + test::vec_toml(v[k]) + "\n";
-    return b;
-  };
   const std::string head = "[run]\nduration = 3600.0\ndt = 0.5\n[environment]\nlatitude = 75.0\n";
-  const Scene steady = test::scene_from(head + "current = [0.3, -0.1]\nwind = [8.0, 3.0]\n" + floes());
+  const Scene steady = test::scene_from(head + "current = [0.3, -0.1]\nwind = [8.0, 3.0]\n" + three_floes());
   const Scene series = test::scene_from(head + "[environment.current_file]\nfile = \"" + (dir / "current.csv").string() +
                                         "\"\n[environment.wind_file]\nfile = \"" + (dir / "wind.csv").string() +
-                                        "\"\nu = \"east\"\nv = \"north\"\n" + floes());
+                                        "\"\nu = \"east\"\nv = \"north\"\n" + three_floes());
   REQUIRE(series.environment.current_varies());
   REQUIRE(series.environment.wind_varies());
   REQUIRE(series.environment.sea_surface_tilt);
@@ -362,18 +364,9 @@ TEST_CASE("a gridded current constant in space and time gives the steady run to 
   g.time = {-1.0, 0.5, 2.0};
   g.field = [](double, double, double, double) { return Vec2{0.25, -0.125}; };
   write_grid(dir / "ocean.nc", g);
-  auto floes = [] {
-    std::string b;
-    const Vec2 at[] = {{0, 0}, {30, 2}, {60, -3}};
-    const Vec2 v[] = {{0.5, 0.0}, {-0.2, 0.0}, {0.0, 0.1}};
-    for (int k = 0; k < 3; ++k)
-      b += "[[body]]\nname = \"f" + std::to_string(k) + "\"\npolygon = " + test::toml_polygon(test::box(at[k], 20, 16, 0.2)) +
-           "\nthickness = 1.5\nvelocity = " + test::vec_toml(v[k]) + "\n";
-    return b;
-  };
   const std::string head = std::string(kStart) + "duration = 3600.0\ndt = 0.5\n[environment]\nlatitude = 75.0\nwind = [6.0, 2.0]\n";
-  const Scene steady = test::scene_from(head + "current = [0.25, -0.125]\n" + floes());
-  const Scene gridded = test::scene_from(head + grid_table(dir / "ocean.nc") + floes());
+  const Scene steady = test::scene_from(head + "current = [0.25, -0.125]\n" + three_floes());
+  const Scene gridded = test::scene_from(head + grid_table(dir / "ocean.nc") + three_floes());
   REQUIRE(gridded.environment.current_grid.time.size() == 3);
   CHECK(gridded.environment.current_grid.time.front() == -3600.0);
   Stepper a(steady, "native"), b(gridded, "native");
