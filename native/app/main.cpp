@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <algorithm>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -157,6 +158,19 @@ struct CheckCommand {
                   << (grid->depth.empty() ? std::string() : ", " + std::to_string(grid->depth.size()) + " depths")
                   << ", " << grid->time.size() << " times over [" << grid->time.front() << ", " << grid->time.back()
                   << "] s, the run [0, " << scene.run.duration << "] s\n";
+    if (scene.geo.present) {
+      // Where the bodies lie on the earth: their centroids' extent in longitude and latitude.
+      const floedem::GeoProjection projection(scene.geo);
+      double lon[2] = {1e9, -1e9}, lat[2] = {1e9, -1e9};
+      for (const floedem::BodySpec& b : scene.bodies) {
+        const floedem::LonLat g = projection.to_lonlat(b.centroid);
+        lon[0] = std::min(lon[0], g.lon), lon[1] = std::max(lon[1], g.lon);
+        lat[0] = std::min(lat[0], g.lat), lat[1] = std::max(lat[1], g.lat);
+      }
+      std::cout << "  geo: origin " << scene.geo.origin_lon << " E, " << scene.geo.origin_lat << " N; projection \""
+                << scene.geo.projection << "\"; bodies over longitude [" << lon[0] << ", " << lon[1] << "], latitude ["
+                << lat[0] << ", " << lat[1] << "]" << (env.coriolis ? "; Coriolis at each body's latitude" : "") << "\n";
+    }
     for (const floedem::TidalConstituent& c : env.tides)
       std::cout << "  tide " << (c.name.empty() ? "period " + std::to_string(c.period) + " s" : c.name) << ": major "
                 << c.major << " m/s, minor " << c.minor << " m/s\n";
@@ -199,18 +213,24 @@ struct SweepCommand {
 
 struct ExportCommand {
   std::string run_file, out;
-  bool xdmf = false;
+  bool xdmf = false, geojson = false;
   CLI::App* app = nullptr;
 
   void add(CLI::App& parent) {
-    app = parent.add_subcommand(
-        "export", "write a run as XDMF for ParaView, beside it: RESULT.xdmf and RESULT.xdmf.h5 (the run's file is only read)");
+    app = parent.add_subcommand("export",
+                                "write a run beside it as XDMF for ParaView (RESULT.xdmf and RESULT.xdmf.h5) or, a "
+                                "geographic scene's, as GeoJSON for QGIS (RESULT.geojson); the run's file is only read");
     app->add_option("run", run_file, "a run's output, RESULT.h5")->required();
-    app->add_flag("--xdmf", xdmf, "XDMF (the one format for now)")->required();
-    app->add_option("--out,-o", out, "the XDMF file (default: RESULT.xdmf beside the run)");
+    CLI::Option* x = app->add_flag("--xdmf", xdmf, "XDMF for ParaView");
+    CLI::Option* g = app->add_flag("--geojson", geojson,
+                                   "GeoJSON: each body's track and its last frame's polygon in longitude and latitude");
+    x->excludes(g);
+    app->require_option(1, 0);
+    app->add_option("--out,-o", out, "the file (default: RESULT.xdmf or RESULT.geojson beside the run)");
   }
   int run() const {
-    std::vector<std::string> args{"export", run_file, "--xdmf"};
+    if (!xdmf && !geojson) throw CLI::RequiredError("--xdmf or --geojson");
+    std::vector<std::string> args{"export", run_file, geojson ? "--geojson" : "--xdmf"};
     if (!out.empty()) args.insert(args.end(), {"--out", out});
     return python_status(args);
   }

@@ -18,13 +18,16 @@
 
 namespace floedem {
 
+class CoriolisField;
 class DistributedDrag;
 class FlowGrid;
 
-/// The scene's gridded wind and current (flow_grid.hpp), each null where the scene has none:
-/// built and prepared once a step by Forcing, read by the terms that take them.
+/// What varies over the scene's plane, each null where the scene has none: the gridded wind and
+/// current (flow_grid.hpp), built and prepared once a step by Forcing, and the Coriolis
+/// parameter of a geographic scene (coriolis_field.hpp); read by the terms that take them.
 struct FlowFields {
   std::unique_ptr<FlowGrid> current, wind;
+  std::unique_ptr<CoriolisField> coriolis;
 };
 
 /// One body's generalised force Q and Jacobian dQ/dq while a term adds to it point by point:

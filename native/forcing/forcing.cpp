@@ -43,6 +43,7 @@
 
 #include "floedem/scene/input_error.hpp"
 #include "forcing/drag_pass.hpp"
+#include "forcing/coriolis_field.hpp"
 #include "forcing/flow_grid.hpp"
 #include "forcing/forcing.hpp"
 #include "parallel/thread_pool.hpp"
@@ -99,6 +100,7 @@ Forcing::Forcing(const Scene& scene, bool share_drag_pass) : scene_(scene), dt_(
   const EnvironmentSpec& env = scene.environment;
   if (!env.current_grid.empty()) fields_.current = std::make_unique<FlowGrid>(env.current_grid);
   if (!env.wind_grid.empty()) fields_.wind = std::make_unique<FlowGrid>(env.wind_grid);
+  if (scene.geo.present && env.coriolis) fields_.coriolis = std::make_unique<CoriolisField>(scene.geo);
   bool gridded = false;
   for (auto& t : terms_) {
     t->attach_fields(fields_);

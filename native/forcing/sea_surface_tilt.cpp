@@ -2,7 +2,9 @@
 // Bigg et al. 1997): F = m (dV_w/dt + f k x V_w), with V_w the current averaged over the
 // body's draft. A steady current gives F = m f k x V_w, computed once; a current that changes
 // in time (tides, a series: uniform over the scene and over depth) adds its change and its
-// rate at each step.
+// rate at each step. In a geographic scene f is each body's own, at its centroid
+// (coriolis_field.hpp).
+#include "forcing/coriolis_field.hpp"
 #include "forcing/flow_grid.hpp"
 #include "forcing/force_term.hpp"
 
@@ -15,12 +17,13 @@ class SeaSurfaceTilt final : public ForceTerm {
   explicit SeaSurfaceTilt(const Scene& scene) : environment_(scene.environment) {
     const EnvironmentSpec& env = scene.environment;
     varies_ = env.current_varies();
+    const bool geographic = scene.geo.present;
     for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
       const BodySpec& b = scene.bodies[i];
       if (b.fixed) continue;
       const Vec2 v = draft_mean(b, env);
       const Vec2 f = (b.mass * env.coriolis_parameter) * cross(1.0, v);
-      if (varies_ || f != Vec2{}) entries_.push_back({i, f, &b});
+      if (varies_ || f != Vec2{} || (geographic && v != Vec2{})) entries_.push_back({i, f, v, &b});
     }
   }
   bool empty() const { return entries_.empty(); }
@@ -28,7 +31,11 @@ class SeaSurfaceTilt final : public ForceTerm {
   bool add_rate_bound(const BodyStatesView&, ForceSums&) const override { return true; }  // no Jacobian
   void add(const BodyStatesView& state, double time, ForceSums& sums) const override {
     if (!varies_) {
-      for (const Entry& e : entries_) sums.add_force(e.body, e.force, 0.0);
+      if (coriolis_)
+        for (const Entry& e : entries_)
+          sums.add_force(e.body, (e.spec->mass * coriolis_->at(state.position[e.body])) * cross(1.0, e.current), 0.0);
+      else
+        for (const Entry& e : entries_) sums.add_force(e.body, e.force, 0.0);
       return;
     }
     const Vec2 change = environment_.current_change(time), rate = environment_.current_change_rate(time);
@@ -44,10 +51,14 @@ class SeaSurfaceTilt final : public ForceTerm {
       } else {
         v = draft_mean(*e.spec, environment_, [&](double) { return change; });
       }
-      sums.add_force(e.body, (e.spec->mass * environment_.coriolis_parameter) * cross(1.0, v) + e.spec->mass * dv, 0.0);
+      const double f = coriolis_ ? coriolis_->at(state.position[e.body]) : environment_.coriolis_parameter;
+      sums.add_force(e.body, (e.spec->mass * f) * cross(1.0, v) + e.spec->mass * dv, 0.0);
     }
   }
-  void attach_fields(const FlowFields& fields) override { grid_ = fields.current.get(); }
+  void attach_fields(const FlowFields& fields) override {
+    grid_ = fields.current.get();
+    coriolis_ = fields.coriolis.get();
+  }
 
  private:
   /// The current averaged over the body's draft (16 samples a keel layer), plus `change` at
@@ -77,11 +88,13 @@ class SeaSurfaceTilt final : public ForceTerm {
   }
   struct Entry {
     std::size_t body;
-    Vec2 force;  // m f k x V_w of a steady current
+    Vec2 force;    // m f k x V_w of a steady current
+    Vec2 current;  // its V_w
     const BodySpec* spec;
   };
   const EnvironmentSpec& environment_;
   const FlowGrid* grid_ = nullptr;
+  const CoriolisField* coriolis_ = nullptr;
   bool varies_ = false;
   std::vector<Entry> entries_;
 };

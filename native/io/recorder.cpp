@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "floedem/engine/state_io.hpp"
+#include "floedem/scene/geo.hpp"
 #include "floedem/scene/input_error.hpp"
 #include "floedem/version.hpp"
 #include "io/h5_read.hpp"
@@ -181,6 +182,10 @@ struct Recorder::Impl {
   hsize_t frame_chunk = 1;
   std::vector<double> b_time, b_position, b_angle, b_velocity, b_angular_velocity;
   hsize_t buffered_frames = 0;
+  // A geographic scene's longitude and latitude of each body per frame (docs/geography.md).
+  std::unique_ptr<GeoProjection> geo;
+  Series lonlat;
+  std::vector<double> b_lonlat;
   // Contacts.
   Series c_time, c_body_a, c_body_b, c_point, c_normal, c_normal_impulse, c_tangent_impulse, c_approach, c_separation,
       c_kind;
@@ -227,6 +232,9 @@ struct Recorder::Impl {
         {&angle, "/bodies/angle", f64, {n}, frame_chunk, &R::frames},
         {&velocity, "/bodies/velocity", f64, {n, 2}, frame_chunk, &R::frames},
         {&angular_velocity, "/bodies/angular_velocity", f64, {n}, frame_chunk, &R::frames},
+    };
+    if (scene.geo.present) t.push_back({&lonlat, "/bodies/lonlat", f64, {n, 2}, frame_chunk, &R::frames});
+    t.insert(t.end(), {
         {&c_time, "/contacts/time", f64, {}, kc, &R::contacts},
         {&c_body_a, "/contacts/body_a", i32, {}, kc, &R::contacts},
         {&c_body_b, "/contacts/body_b", i32, {}, kc, &R::contacts},
@@ -247,7 +255,7 @@ struct Recorder::Impl {
         {&e_duration, "/contacts/collisions/duration", f64, {}, ke, &R::collisions},
         {&e_mean, "/contacts/collisions/mean_force", f64, {}, ke, &R::collisions},
         {&e_peak, "/contacts/collisions/peak_force", f64, {}, ke, &R::collisions},
-    };
+    });
     if (tow) {
       t.push_back({&tow_time, "/tow/time", f64, {}, kt, &R::tow});
       t.push_back({&tow_force, "/tow/force", f64, {2}, kt, &R::tow});
@@ -270,6 +278,8 @@ struct Recorder::Impl {
       angle.append(b_angle.data(), buffered_frames);
       velocity.append(b_velocity.data(), buffered_frames);
       angular_velocity.append(b_angular_velocity.data(), buffered_frames);
+      if (geo) lonlat.append(b_lonlat.data(), buffered_frames);
+      b_lonlat.clear();
       b_time.clear(); b_position.clear(); b_angle.clear(); b_velocity.clear(); b_angular_velocity.clear();
       buffered_frames = 0;
     }
@@ -410,6 +420,13 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
       for (const std::size_t i : scene.output.load_bodies) load_ids.push_back(static_cast<std::int32_t>(i));
       write_fixed(loads, "body", H5::PredType::NATIVE_INT32, load_ids, {load_ids.size()});
     }
+    if (scene.geo.present) {
+      d.geo = std::make_unique<GeoProjection>(scene.geo);
+      H5::Group geo = d.file.createGroup("/geo");
+      write_attribute(geo, "origin_lon", scene.geo.origin_lon);
+      write_attribute(geo, "origin_lat", scene.geo.origin_lat);
+      write_text(geo, "projection", scene.geo.projection, d.fixed_strings);
+    }
     d.frame_chunk = frame_chunk_of(n);
     for (const Impl::Table& t : d.tables(scene)) *t.series = Series(root, t.path, t.type, t.row_shape, t.chunk);
     for (const Provenance& p : scene.provenance) {
@@ -470,6 +487,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& r
     d.frame_chunk = frame_chunk_of(d.bodies);
     d.contact_output = scene.output.contacts;
     d.tow = scene.tow.mode != TowSpec::Mode::none;
+    if (scene.geo.present) d.geo = std::make_unique<GeoProjection>(scene.geo);
     for (const Impl::Table& t : d.tables(scene)) {
       *t.series = Series(d.file.openDataSet(t.path), t.type);
       t.series->truncate(static_cast<hsize_t>(rows.*t.rows), partial_path_ + ": " + t.path);
@@ -543,7 +561,7 @@ std::int64_t Recorder::check_tables(const std::string& file, const Scene& scene,
 
 void Recorder::check_space(const Scene& scene) const {
   // The frames' size is known before the run: 6 doubles per body and frame (position, angle,
-  // velocity, angular velocity), plus /tow's 9 per row and /loads' 1 + 2 per body per row. A
+  // velocity, angular velocity; 8 with a geographic scene's longitude and latitude), plus /tow's 9 per row and /loads' 1 + 2 per body per row. A
   // disk too small for them is told now, not hours into the run (contact rows depend on the run
   // and are not counted).
   const double steps = static_cast<double>(scene.run.steps());
@@ -551,7 +569,7 @@ void Recorder::check_space(const Scene& scene) const {
   const double tow_rows = scene.tow.mode == TowSpec::Mode::none ? 0.0 : steps / scene.tow_every() + 2.0;
   const double load_rows = scene.output.load_bodies.empty() ? 0.0 : steps / scene.load_every() + 2.0;
   const double bytes =
-      8.0 * (frames * (6.0 * static_cast<double>(scene.bodies.size()) + 1.0) + 9.0 * tow_rows +
+      8.0 * (frames * ((scene.geo.present ? 8.0 : 6.0) * static_cast<double>(scene.bodies.size()) + 1.0) + 9.0 * tow_rows +
              load_rows * (1.0 + 2.0 * static_cast<double>(scene.output.load_bodies.size())));
   const std::filesystem::path dir = std::filesystem::absolute(path_).parent_path();
   struct statvfs fs {};
@@ -589,6 +607,12 @@ void Recorder::write_frame(double time, const BodyStates& state) {
     d.b_velocity.push_back(state.velocity[i].y);
     d.b_angular_velocity.push_back(state.angular_velocity[i]);
   }
+  if (d.geo)
+    for (std::size_t i = 0; i < d.bodies; ++i) {
+      const LonLat g = d.geo->to_lonlat(state.position[i]);  // NaN beyond the projection's domain
+      d.b_lonlat.push_back(g.lon);
+      d.b_lonlat.push_back(g.lat);
+    }
   ++d.buffered_frames;
   try {
     if (d.buffered_frames >= d.frame_chunk) d.flush();

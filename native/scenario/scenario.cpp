@@ -14,6 +14,7 @@
 #include "floedem/field/field_generator.hpp"
 #include "geometry/polygon.hpp"
 #include "floedem/io/output.hpp"
+#include "floedem/scene/geo.hpp"
 #include "scenario/met_ocean_input.hpp"
 #include "scenario/table_reader.hpp"
 #include "floedem/scene/input_error.hpp"
@@ -120,6 +121,69 @@ void read_run(TableReader& root, Scene& scene) {
   r.reject_unknown();
 }
 
+/// [geo]: the scene's origin on the earth and its projection (floedem/scene/geo.hpp). Returns
+/// the projection, or null for a scene in plain metres.
+std::unique_ptr<GeoProjection> read_geo(TableReader& root, Scene& scene) {
+  const toml::table* t = root.table("geo");
+  if (!t) return nullptr;
+  TableReader r(*t, scene.source_path, "geo");
+  const Vec2 origin = r.vec2("origin", std::nullopt);
+  if (!(origin.x >= -180.0 && origin.x <= 180.0))
+    r.fail("origin", "longitude " + std::to_string(origin.x) + " deg; allowed [-180, 180]");
+  if (!(origin.y > -90.0 && origin.y < 90.0))
+    r.fail("origin", "latitude " + std::to_string(origin.y) + " deg; allowed (-90, 90)");
+  GeoSpec& geo = scene.geo;
+  geo.present = true;
+  geo.origin_lon = origin.x;
+  geo.origin_lat = origin.y;
+  geo.projection_given = r.string("projection", "");
+  geo.projection = geo.projection_given.empty() ? GeoSpec::default_projection(origin.x, origin.y) : geo.projection_given;
+  std::unique_ptr<GeoProjection> projection;
+  try {
+    projection = std::make_unique<GeoProjection>(geo);
+  } catch (const InputError& e) {
+    r.fail(geo.projection_given.empty() ? "origin" : "projection", e.what());
+  }
+  r.reject_unknown();
+  return projection;
+}
+
+/// A point or polygon given in longitude and latitude (degrees), on the scene's plane.
+Vec2 lonlat_point(TableReader& r, std::string_view key, Vec2 p, const GeoProjection* geo, const std::string& which) {
+  if (!(p.x >= -180.0 && p.x <= 360.0 && p.y >= -90.0 && p.y <= 90.0))
+    r.fail(key, which + "(" + std::to_string(p.x) + ", " + std::to_string(p.y) +
+                    ") is not a longitude and latitude; allowed [-180, 360] and [-90, 90] deg");
+  try {
+    return geo->to_plane({p.x, p.y});
+  } catch (const InputError& e) {
+    r.fail(key, which + e.what());
+  }
+}
+
+void need_geo(TableReader& r, std::string_view key, const GeoProjection* geo) {
+  if (!geo) r.fail(key, "needs a [geo] table (the scene's origin on the earth) to place longitudes and latitudes");
+}
+
+/// `key` in metres, or `key`_lonlat in degrees of a geographic scene, one of them.
+std::vector<Vec2> read_polygon(TableReader& r, const std::string& key, const GeoProjection* geo) {
+  const std::string geo_key = key + "_lonlat";
+  if (!r.has(geo_key)) return r.points(key);
+  need_geo(r, geo_key, geo);
+  if (r.has(key)) r.fail(geo_key, "give " + key + " (m) or " + geo_key + " (deg), not both");
+  std::vector<Vec2> out = r.points(geo_key);
+  for (std::size_t k = 0; k < out.size(); ++k) out[k] = lonlat_point(r, geo_key, out[k], geo, "vertex " + std::to_string(k) + " ");
+  return out;
+}
+
+/// A position in metres (`key`, or `fallback` where neither is given) or in degrees.
+Vec2 read_position(TableReader& r, const std::string& key, Vec2 fallback, const GeoProjection* geo) {
+  const std::string geo_key = key + "_lonlat";
+  if (!r.has(geo_key)) return r.vec2(key, fallback);
+  need_geo(r, geo_key, geo);
+  if (r.has(key)) r.fail(geo_key, "give " + key + " (m) or " + geo_key + " (deg), not both");
+  return lonlat_point(r, geo_key, r.vec2(geo_key, std::nullopt), geo, "");
+}
+
 void read_contact(TableReader& root, Scene& scene) {
   const toml::table* t = root.table("contact");
   if (!t) return;
@@ -157,7 +221,7 @@ void read_output(TableReader& root, Scene& scene) {
 }
 
 void check_polygon(TableReader& r, BodySpec& b) {
-  if (const auto problem = polygon_problem(b.polygon)) r.fail("polygon", *problem);
+  if (const auto problem = polygon_problem(b.polygon)) r.fail(r.has("polygon_lonlat") ? "polygon_lonlat" : "polygon", *problem);
   const double a = signed_area(b.polygon);
   if (a < 0.0) {
     std::reverse(b.polygon.begin(), b.polygon.end());
@@ -208,12 +272,17 @@ EnvironmentDefaults read_environment(TableReader& root, Scene& scene) {
   env.air_density = r.real("air_density", env.air_density, Range::non_negative());
   env.gravity = r.real("gravity", env.gravity, Range::non_negative());
   defaults.ice_density = r.real("ice_density", defaults.ice_density, Range::positive());
-  if (r.has("latitude")) {
+  if (scene.geo.present) {  // f follows each body's latitude (forcing/coriolis_field.hpp)
+    if (r.has("latitude"))
+      r.fail("latitude", "a geographic scene takes each body's latitude from [geo]; remove environment.latitude");
+    env.coriolis = true;
+    env.latitude = scene.geo.origin_lat * M_PI / 180.0;
+    env.coriolis_parameter = coriolis_parameter(scene.geo.origin_lat);
+  } else if (r.has("latitude")) {
     const double degrees = r.real("latitude", 0.0, Range::closed(-90.0, 90.0));
-    constexpr double kEarthRotation = 7.2921e-5;  // rad/s, sidereal (docs/model.md 2)
     env.coriolis = true;
     env.latitude = degrees * M_PI / 180.0;
-    env.coriolis_parameter = 2.0 * kEarthRotation * std::sin(env.latitude);
+    env.coriolis_parameter = coriolis_parameter(degrees);
   }
   const bool current_flows = env.current != Vec2{} || !env.current_profile.empty() || env.current_varies();
   env.sea_surface_tilt = r.boolean("sea_surface_tilt", env.coriolis && current_flows);
@@ -270,7 +339,7 @@ std::vector<std::pair<double, Vec2>> read_path(TableReader& r, const char* const
   return path;
 }
 
-void read_tow(TableReader& root, Scene& scene) {
+void read_tow(TableReader& root, Scene& scene, const GeoProjection* geo) {
   const toml::table* t = root.table("tow");
   if (!t) return;
   TableReader r(*t, scene.source_path, "tow");
@@ -302,7 +371,7 @@ void read_tow(TableReader& root, Scene& scene) {
     // Default tug start: the rope's length ahead of the attachment, along the tug's first velocity.
     const Vec2 heading = length(tow.path.front().second) > 0.0 ? normalized(tow.path.front().second) : Vec2{1.0, 0.0};
     const AreaMoments m = area_moments(b.polygon);
-    tow.tug_start = r.vec2("tug_start", m.centroid + tow.attachment + tow.length * heading);
+    tow.tug_start = read_position(r, "tug_start", m.centroid + tow.attachment + tow.length * heading, geo);
   }
   r.reject_unknown();
 }
@@ -329,7 +398,7 @@ std::vector<KeelLayer> read_keel(TableReader& r, double draft) {
 }
 
 void read_bodies(TableReader& root, Scene& scene, double ice_density, const DragCoefficients& drag_floe,
-                 const DragCoefficients& drag_iceberg) {
+                 const DragCoefficients& drag_iceberg, const GeoProjection* geo) {
   const auto tables = root.array_of_tables("body");
   std::set<std::string> names;
   for (std::size_t i = 0; i < tables.size(); ++i) {
@@ -338,7 +407,15 @@ void read_bodies(TableReader& root, Scene& scene, double ice_density, const Drag
     b.name = r.string("name", "body-" + std::to_string(i));
     if (b.name.empty()) r.fail("name", "is empty; allowed a non-empty string");
     if (!names.insert(b.name).second) r.fail("name", "\"" + b.name + "\" is used by an earlier body; names must be unique");
-    b.polygon = r.points("polygon");
+    b.polygon = read_polygon(r, "polygon", geo);
+    if (r.has("position_lonlat")) {  // the polygon (m) about its centroid, placed there
+      need_geo(r, "position_lonlat", geo);
+      if (r.has("polygon_lonlat")) r.fail("position_lonlat", "places a polygon given in metres; polygon_lonlat is placed already");
+      const Vec2 at = lonlat_point(r, "position_lonlat", r.vec2("position_lonlat", std::nullopt), geo, "");
+      if (const auto problem = polygon_problem(b.polygon)) r.fail("polygon", *problem);
+      const Vec2 shift = at - area_moments(b.polygon).centroid;
+      for (Vec2& v : b.polygon) v += shift;
+    }
     check_polygon(r, b);
     const std::string kind = r.string("kind", "floe", {"floe", "iceberg"});
     b.kind = kind == "iceberg" ? BodyKind::iceberg : BodyKind::floe;
@@ -379,7 +456,8 @@ void read_bodies(TableReader& root, Scene& scene, double ice_density, const Drag
 
 /// [field]: floes generated by the field generator (field/field_generator.hpp), or read from
 /// a field file or a run's output. The scenario's own bodies are kept out of a generated field.
-void read_field(TableReader& root, Scene& scene, double ice_density, const DragCoefficients& drag_floe) {
+void read_field(TableReader& root, Scene& scene, double ice_density, const DragCoefficients& drag_floe,
+                const GeoProjection* geo) {
   const toml::table* t = root.table("field");
   if (!t) return;
   TableReader r(*t, scene.source_path, "field");
@@ -387,7 +465,7 @@ void read_field(TableReader& root, Scene& scene, double ice_density, const DragC
   const std::string prefix = r.string("name_prefix", "floe-");
   std::vector<BodySpec> floes;
   if (r.has("file")) {
-    for (const char* k : {"width", "height", "origin", "concentration", "alpha", "d_min", "d_max", "thickness",
+    for (const char* k : {"width", "height", "origin", "origin_lonlat", "concentration", "alpha", "d_min", "d_max", "thickness",
                           "irregularity", "seed", "keep_out", "velocity"})
       if (r.has(k)) r.fail(k, "is for a generated field; with field.file the floes are read as they are");
     std::filesystem::path file = r.string("file", std::nullopt);
@@ -415,7 +493,7 @@ void read_field(TableReader& root, Scene& scene, double ice_density, const DragC
     FieldSpec spec;
     spec.width = r.real("width", std::nullopt, Range::positive());
     spec.height = r.real("height", std::nullopt, Range::positive());
-    spec.origin = r.vec2("origin", Vec2{});
+    spec.origin = read_position(r, "origin", Vec2{}, geo);
     spec.concentration = r.real("concentration", std::nullopt, Range{0.0, FieldSpec::max_concentration, true, false});
     spec.alpha = r.real("alpha", std::nullopt, Range{0.0, 10.0, true, false});
     spec.d_min = r.real("d_min", std::nullopt, Range::positive());
@@ -443,7 +521,7 @@ void read_field(TableReader& root, Scene& scene, double ice_density, const DragC
     for (std::size_t k = 0; k < zones.size(); ++k) {
       TableReader zr(*zones[k], scene.source_path, "field.keep_out[" + std::to_string(k) + "]");
       BodySpec zone;
-      zone.polygon = zr.points("polygon");
+      zone.polygon = read_polygon(zr, "polygon", geo);
       check_polygon(zr, zone);
       zr.reject_unknown();
       spec.keep_out.push_back(zone.polygon);
@@ -506,13 +584,14 @@ Scene parse_scenario(const std::string& text, const std::string& path, const std
   TableReader root(doc, path, "");
   read_run(root, scene);
   read_contact(root, scene);
+  const std::unique_ptr<GeoProjection> geo = read_geo(root, scene);
   const EnvironmentDefaults defaults = read_environment(root, scene);
-  read_bodies(root, scene, defaults.ice_density, defaults.floe, defaults.iceberg);
-  read_field(root, scene, defaults.ice_density, defaults.floe);
+  read_bodies(root, scene, defaults.ice_density, defaults.floe, defaults.iceberg, geo.get());
+  read_field(root, scene, defaults.ice_density, defaults.floe, geo.get());
   read_output(root, scene);  // after the bodies: [output] loads names them
   check_grid_coverage(scene);
   if (scene.bodies.empty()) root.fail("body", "no [[body]] and no [field] given; allowed at least one body");
-  read_tow(root, scene);
+  read_tow(root, scene, geo.get());
   read_engines(root, scene);
   root.reject_unknown();
 

@@ -10,10 +10,14 @@ from .errors import FileError
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="floedem", description="floedem's results: export and films")
     sub = ap.add_subparsers(dest="command", required=True)
-    ex = sub.add_parser("export", help="write a run as XDMF for ParaView, beside it (RUN.xdmf and RUN.xdmf.h5)")
+    ex = sub.add_parser("export", help="write a run as XDMF for ParaView (RUN.xdmf and RUN.xdmf.h5) or as GeoJSON "
+                                       "for QGIS (RUN.geojson), beside it")
     ex.add_argument("run", help="a run's output, RESULT.h5")
-    ex.add_argument("--xdmf", action="store_true", required=True, help="XDMF (the one format for now)")
-    ex.add_argument("--out", "-o", help="the XDMF file (default: RESULT.xdmf beside the run)")
+    kind = ex.add_mutually_exclusive_group(required=True)
+    kind.add_argument("--xdmf", action="store_true", help="XDMF for ParaView")
+    kind.add_argument("--geojson", action="store_true", help="GeoJSON of a geographic scene's run: tracks and the "
+                                                               "last frame's bodies in longitude and latitude")
+    ex.add_argument("--out", "-o", help="the file (default: RESULT.xdmf or RESULT.geojson beside the run)")
     an = sub.add_parser("animate", help="write a film of a run (ffmpeg)")
     an.add_argument("run", help="a run's output, RESULT.h5")
     an.add_argument("--out", "-o", help="the film (default: RESULT.mp4 beside the run; .gif also works)")
@@ -55,7 +59,10 @@ def main(argv=None):
             from .sweep import reduce
             reduce(a.sweep_json)
             return 0
-        if a.command == "export":
+        if a.command == "export" and a.geojson:
+            from .geojson import export
+            print(export(a.run, a.out))
+        elif a.command == "export":
             from .xdmf import export
             print(export(a.run, a.out))
         else:

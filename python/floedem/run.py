@@ -90,7 +90,9 @@ class Run:
     polygon_offsets through local_polygons()), position [T, N, 2], angle [T, N], velocity
     [T, N, 2], angular_velocity [T, N], contacts, collisions, tow, loads (Tables, or None when
     the file has none), summary (the summary_* attributes without the prefix), engine_info
-    (/engine's attributes), provenance ({group: attributes}, e.g. "field")."""
+    (/engine's attributes), provenance ({group: attributes}, e.g. "field"); a geographic
+    scene's run (docs/geography.md) also geo (/geo's attributes: origin_lon, origin_lat,
+    projection; None for a scene in plain metres) and lonlat [T, N, 2] (deg)."""
 
     def __init__(self, path):
         self.path = os.fspath(path)
@@ -158,6 +160,15 @@ class Run:
         self.summary = {k[len("summary_"):]: v for k, v in self.attrs.items() if k.startswith("summary_")}
         self.engine_info = _attrs(f["engine"]) if "engine" in f else {}
         self.provenance = {name: _attrs(f[name]) for name in ("field",) if name in f}
+        self.geo = _attrs(f["geo"]) if "geo" in f else None
+        if self.geo is not None:
+            missing = [k for k in ("origin_lon", "origin_lat", "projection") if k not in self.geo]
+            if missing or "lonlat" not in f["bodies"]:
+                raise self._error("/geo", f"a geographic run needs /geo's origin_lon, origin_lat, projection and "
+                                          f"/bodies/lonlat; missing {', '.join(missing) or '/bodies/lonlat'}")
+            if f["bodies/lonlat"].shape != (len(self.time), n, 2):
+                raise self._error("/bodies/lonlat", f"has shape {f['bodies/lonlat'].shape}; expected "
+                                                    f"{(len(self.time), n, 2)}")
 
     # Frames -----------------------------------------------------------------------------------
     @property
@@ -179,6 +190,11 @@ class Run:
     def angular_velocity(self):
         """[T, N] rad/s."""
         return self._frames.angular_velocity
+
+    @property
+    def lonlat(self):
+        """[T, N, 2] deg: the centroids' longitude and latitude (a geographic scene's run), or None."""
+        return self._file["bodies/lonlat"][()] if self.geo is not None else None
 
     @property
     def frames(self):

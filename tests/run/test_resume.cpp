@@ -216,6 +216,25 @@ TEST_CASE("resume: a run killed mid-way and continued gives the uninterrupted ru
   fs::remove_all(f.dir);
 }
 
+TEST_CASE("resume: a geographic run killed and continued gives the uninterrupted run's file", "[resume][geo]") {
+  // The same scene on the earth (docs/geography.md): each body's Coriolis parameter comes from
+  // tiles of a lattice built as the bodies reach them, and /bodies/lonlat is written per frame.
+  std::string text = kScenario;
+  const std::string latitude = "latitude = 70.0\n";
+  REQUIRE(text.find(latitude) != std::string::npos);
+  text.replace(text.find(latitude), latitude.size(), "");
+  const Files f = write_scenario("geo", text + "[geo]\norigin = [20.0, 70.0]\n");
+  REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+  REQUIRE(whole.count("/bodies/lonlat"));
+  REQUIRE(test::run_cli(run_args(f, "cut.h5"), "FLOEDEM_TEST_KILL_AT_STEP=777 ").code != 0);
+  const auto resumed = test::run_cli("run --resume " + (f.dir / "cut.h5").string());
+  INFO(resumed.output);
+  REQUIRE(resumed.code == 0);
+  check_same_contents(whole, f.dir / "cut.h5");
+  fs::remove_all(f.dir);
+}
+
 TEST_CASE("resume: killed twice, and a damaged checkpoint falls back to the other slot", "[resume]") {
   const Files f = write_scenario("twice");
   REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);

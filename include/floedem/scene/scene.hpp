@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "floedem/geometry/vec2.hpp"
+#include "floedem/scene/geo.hpp"
 #include "floedem/scene/met_ocean.hpp"
 
 namespace floedem {
@@ -115,9 +116,10 @@ struct EnvironmentSpec {
   Vec2 current;                             ///< m/s, uniform (used when there is no profile)
   std::vector<CurrentLayer> current_profile;///< by depth, first layer at depth 0
   Vec2 wind;                                ///< m/s, at sail height
-  bool coriolis = false;                    ///< a latitude was given
-  double latitude = 0.0;                    ///< rad
-  double coriolis_parameter = 0.0;          ///< f = 2 Omega sin(latitude), 1/s
+  bool coriolis = false;                    ///< a latitude was given, or the scene is geographic
+  double latitude = 0.0;                    ///< rad (a geographic scene: its origin's)
+  double coriolis_parameter = 0.0;          ///< f = 2 Omega sin(latitude), 1/s (at the origin
+                                            ///< of a geographic scene, where each body has its own)
   bool sea_surface_tilt = false;            ///< m f k x V_w (geostrophic current)
   WaveSpec waves;
   double water_density = 1025.0;            ///< kg/m^3
@@ -182,6 +184,7 @@ struct Scene {
   std::vector<std::string> overrides;  ///< --set KEY=VALUE applied on top, in order
 
   RunSettings run;
+  GeoSpec geo;  ///< [geo]: where the plane lies on the earth (geo.present), docs/geography.md
   ContactSettings contact;
   OutputSettings output;
   std::vector<BodySpec> bodies;
