@@ -6,10 +6,10 @@
 # name that matches no test: a renamed test must be renamed here too, which the test "ctest: every
 # test that test_costs.cmake orders exists" (check_test_costs.cmake) holds.
 set(_floedem_slow_tests
-  "every shipped scenario loads|120"
-  "pair cache: every step the same pairs as a fresh broad phase|80"
   "cli: no heap allocation in the steady state of a packed field|70"
-  "coloured_from picks the order per island: its bounds are the shorthand's two orders|50"
+  "every shipped scenario loads|40"
+  "pair cache: every step the same pairs as a fresh broad phase|40"
+  "coloured_from picks the order per island: its bounds are the shorthand's two orders|25"
   "resume: a run killed mid-way and continued gives the uninterrupted run's file|24"
   "field: concentration within 0.005 of the target, no overlap, inside the domain|19")
 foreach(_entry IN LISTS _floedem_slow_tests)

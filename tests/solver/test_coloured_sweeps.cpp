@@ -10,6 +10,7 @@
 #include <cmath>
 #include <random>
 
+#include "app/sanitizer.hpp"
 #include "parallel/thread_pool.hpp"
 #include "parallel/threads.hpp"
 #include "run/stepper.hpp"
@@ -307,7 +308,9 @@ TEST_CASE("coloured_from picks the order per island: its bounds are the shorthan
     const Scene scene = load_scenario(std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/bench/field_wall_1k.toml",
                                       {"environment.current=[1.0, 0.0]", "engine.native." + setting});
     Stepper stepper(scene, "native");
-    for (int k = 0; k < 800; ++k) stepper.step();  // 40 s: islands of some tens of manifolds and more
+    // 40 s (20 s under a sanitizer, five runs at a fifth of the speed): islands of some tens of
+    // manifolds and more by then.
+    for (int k = 0; k < (kSanitizerAllocator ? 400 : 800); ++k) stepper.step();
     return stepper.state();
   };
   check_same_state(run("coloured_from=0"), run("coloured_sweeps=true"));
