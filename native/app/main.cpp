@@ -155,6 +155,11 @@ struct CheckCommand {
         std::cout << "  " << what << " grid " << grid->file << ": " << grid->u << ", " << grid->v << " on x ["
                   << grid->x.front() << ", " << grid->x.back() << "] m (" << grid->x.size() << "), y [" << grid->y.front()
                   << ", " << grid->y.back() << "] m (" << grid->y.size() << ")"
+                  << (grid->lonlat() ? " of the plane, resampled every " + std::to_string(grid->spacing) +
+                                           " m from longitude [" + std::to_string(grid->lon.front()) + ", " +
+                                           std::to_string(grid->lon.back()) + "], latitude [" +
+                                           std::to_string(grid->lat.front()) + ", " + std::to_string(grid->lat.back()) + "]"
+                                     : std::string())
                   << (grid->depth.empty() ? std::string() : ", " + std::to_string(grid->depth.size()) + " depths")
                   << ", " << grid->time.size() << " times over [" << grid->time.front() << ", " << grid->time.back()
                   << "] s, the run [0, " << scene.run.duration << "] s\n";

@@ -62,6 +62,18 @@ bool is_geographic_unit(const std::string& u) {
   return l.rfind("degree", 0) == 0;
 }
 
+// CF's spellings of longitude and latitude units (CF conventions 4.1 and 4.2).
+bool is_longitude_unit(const std::string& u) {
+  const std::string l = lower(u);
+  return l == "degrees_east" || l == "degree_east" || l == "degree_e" || l == "degrees_e" || l == "degreee" ||
+         l == "degreese";
+}
+bool is_latitude_unit(const std::string& u) {
+  const std::string l = lower(u);
+  return l == "degrees_north" || l == "degree_north" || l == "degree_n" || l == "degrees_n" || l == "degreen" ||
+         l == "degreesn";
+}
+
 /// "<unit> since <instant>" as (seconds per unit, instant in s since 1970), or false.
 bool parse_time_units(const std::string& units, double& per_unit, double& epoch) {
   const std::string l = lower(units);
@@ -144,7 +156,7 @@ Axis read_axis(int nc, int dim, const std::string& path, const std::string& vari
 }  // namespace
 
 FlowGridSpec inspect_flow_grid(const std::string& path, const std::string& u, const std::string& v,
-                               const RunSettings& run) {
+                               const RunSettings& run, const GeoSpec& geo) {
   int nc = -1;
   if (const int e = nc_open(path.c_str(), NC_NOWRITE, &nc); e != NC_NOERR)
     fail(path, "file", std::string("cannot open as NetCDF: ") + nc_strerror(e));
@@ -195,15 +207,30 @@ FlowGridSpec inspect_flow_grid(const std::string& path, const std::string& u, co
       << " (the file must cover the run)";
     fail(path, time.name, o.str());
   }
+  const bool lonlat = is_geographic_unit(x.units) || is_geographic_unit(y.units);
   for (const Axis* a : {&x, &y}) {
-    if (is_geographic_unit(a->units))
-      fail(path, a->name + ".units", "'" + a->units + "': longitude and latitude need a geographic scene; allowed " +
-                                         "x and y in m, the scene's own coordinates");
-    if (!is_length_unit(a->units)) fail(path, a->name + ".units", "'" + a->units + "'; allowed m");
+    if (lonlat && !geo.present)
+      fail(path, a->name + ".units", "'" + a->units + "': longitude and latitude need a geographic scene ([geo]); " +
+                                         "allowed x and y in m, the scene's own coordinates, without one");
+    if (lonlat && a == &x && !is_longitude_unit(a->units))
+      fail(path, a->name + ".units", "'" + a->units + "'; allowed degrees_east (the last dimension is longitude)");
+    if (lonlat && a == &y && !is_latitude_unit(a->units))
+      fail(path, a->name + ".units", "'" + a->units + "'; allowed degrees_north (the last but one is latitude)");
+    if (!lonlat && !is_length_unit(a->units)) fail(path, a->name + ".units", "'" + a->units + "'; allowed m");
     if (a->values.size() < 2) fail(path, a->name, "fewer than 2 points; allowed a grid of at least 2 x 2");
   }
-  spec.x = x.values;
-  spec.y = y.values;
+  if (lonlat) {  // the plane's lattice comes once the bodies are known (place_lonlat_grid)
+    if (y.values.front() < -90.0 || y.values.back() > 90.0)
+      fail(path, y.name, "latitudes " + range_text(y.values) + "; allowed [-90, 90]");
+    if (x.values.back() - x.values.front() > 360.0)
+      fail(path, x.name, "longitudes " + range_text(x.values) + " span more than 360 deg");
+    spec.lon = x.values;
+    spec.lat = y.values;
+    spec.geo = geo;
+  } else {
+    spec.x = x.values;
+    spec.y = y.values;
+  }
   if (n == 4) {
     Axis z = read_axis(nc, dims[0][1], path, u);
     if (!is_length_unit(z.units)) fail(path, z.name + ".units", "'" + z.units + "'; allowed m (depth)");
@@ -215,6 +242,42 @@ FlowGridSpec inspect_flow_grid(const std::string& path, const std::string& u, co
 }
 
 NetcdfSlices::NetcdfSlices(const FlowGridSpec& spec) : spec_(spec) {
+  if (spec.lonlat()) {
+    // Where each node of the plane's lattice falls in the file's grid, and which way east and
+    // north point there: PROJ five times a node, once for the run.
+    const GeoProjection projection(spec.geo);
+    const std::vector<double>& lon = spec.lon;
+    const std::vector<double>& lat = spec.lat;
+    nodes_.resize(spec.x.size() * spec.y.size());
+    auto locate = [](const std::vector<double>& axis, double value, std::ptrdiff_t& index, double& weight) {
+      if (!(value >= axis.front() && value <= axis.back())) return false;
+      const auto k = std::upper_bound(axis.begin(), axis.end(), value) - axis.begin() - 1;
+      index = std::clamp<std::ptrdiff_t>(k, 0, static_cast<std::ptrdiff_t>(axis.size()) - 2);
+      weight = (value - axis[index]) / (axis[index + 1] - axis[index]);
+      return true;
+    };
+    constexpr double kDelta = 1e-4;  // deg: about 11 m of latitude, for the directions
+    for (std::size_t j = 0; j < spec.y.size(); ++j)
+      for (std::size_t i = 0; i < spec.x.size(); ++i) {
+        Node& n = nodes_[j * spec.x.size() + i];
+        const LonLat at = projection.to_lonlat({spec.x[i], spec.y[j]});
+        if (!std::isfinite(at.lat)) continue;
+        double longitude = at.lon;
+        if (longitude < lon.front() && longitude + 360.0 <= lon.back()) longitude += 360.0;
+        if (longitude > lon.back() && longitude - 360.0 >= lon.front()) longitude -= 360.0;
+        std::ptrdiff_t ci = 0, cj = 0;
+        if (!locate(lon, longitude, ci, n.wx) || !locate(lat, at.lat, cj, n.wy)) continue;
+        try {
+          const double up = std::min(at.lat + kDelta, 90.0), down = std::max(at.lat - kDelta, -90.0);
+          n.east = normalized(projection.to_plane({at.lon + kDelta, at.lat}) - projection.to_plane({at.lon - kDelta, at.lat}));
+          n.north = normalized(projection.to_plane({at.lon, up}) - projection.to_plane({at.lon, down}));
+        } catch (const InputError&) {
+          continue;  // at the edge of the projection's domain: no value there
+        }
+        n.i = ci;
+        n.j = cj;
+      }
+  }
   if (const int e = nc_open(spec.file.c_str(), NC_NOWRITE, &ncid_); e != NC_NOERR)
     fail(spec.file, "file", std::string("cannot open as NetCDF: ") + nc_strerror(e));
   for (auto [var, name] : {std::pair{&u_, &spec.u}, std::pair{&v_, &spec.v}}) {
@@ -240,7 +303,9 @@ NetcdfSlices::~NetcdfSlices() {
 }
 
 void NetcdfSlices::read_one(const Variable& var, std::size_t k, std::vector<double>& out) const {
-  const std::size_t nz = std::max<std::size_t>(1, spec_.depth.size()), ny = spec_.y.size(), nx = spec_.x.size();
+  const std::size_t nz = std::max<std::size_t>(1, spec_.depth.size());
+  const std::size_t ny = spec_.lonlat() ? spec_.lat.size() : spec_.y.size();
+  const std::size_t nx = spec_.lonlat() ? spec_.lon.size() : spec_.x.size();
   out.resize(nz * ny * nx);
   std::size_t start[4] = {k, 0, 0, 0}, count[4] = {1, nz, ny, nx};
   if (spec_.depth.empty()) count[1] = ny, count[2] = nx;
@@ -255,8 +320,33 @@ void NetcdfSlices::read_one(const Variable& var, std::size_t k, std::vector<doub
 }
 
 void NetcdfSlices::read(std::size_t k, std::vector<double>& u, std::vector<double>& v) const {
-  read_one(u_, k, u);
-  read_one(v_, k, v);
+  if (!spec_.lonlat()) {
+    read_one(u_, k, u);
+    read_one(v_, k, v);
+    return;
+  }
+  std::vector<double> east, north;  // the file's slice, [depth][lat][lon]
+  read_one(u_, k, east);
+  read_one(v_, k, north);
+  const std::size_t nz = std::max<std::size_t>(1, spec_.depth.size()), nodes = nodes_.size();
+  const std::size_t nlon = spec_.lon.size(), layer = nlon * spec_.lat.size();
+  u.assign(nz * nodes, std::nan(""));
+  v.assign(nz * nodes, std::nan(""));
+  for (std::size_t z = 0; z < nz; ++z)
+    for (std::size_t k2 = 0; k2 < nodes; ++k2) {
+      const Node& n = nodes_[k2];
+      if (n.i < 0) continue;
+      const std::size_t c = z * layer + static_cast<std::size_t>(n.j) * nlon + static_cast<std::size_t>(n.i);
+      // Bilinear in longitude and latitude, as FlowGrid is in x and y; a fill value at a corner
+      // gives NaN, which the run reports where a body meets it.
+      auto blend = [&](const std::vector<double>& a) {
+        return (1.0 - n.wy) * ((1.0 - n.wx) * a[c] + n.wx * a[c + 1]) + n.wy * ((1.0 - n.wx) * a[c + nlon] + n.wx * a[c + nlon + 1]);
+      };
+      const double ue = blend(east), vn = blend(north);
+      const Vec2 w = ue * n.east + vn * n.north;
+      u[z * nodes + k2] = w.x;
+      v[z * nodes + k2] = w.y;
+    }
 }
 
 }  // namespace floedem

@@ -2,6 +2,7 @@
 // A wind or current field from a CF-NetCDF file (docs/forcing.md): its axes checked when the
 // scenario is loaded, its values read a time slice at a time while the run goes.
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -10,15 +11,19 @@
 namespace floedem {
 
 /// The axes of the variables u and v of `path` as a FlowGridSpec: dimensions (time, [depth],
-/// y, x), each with its coordinate variable; x and y in m, depth in m (positive down, or
-/// `positive = "up"`), time in "<unit> since <instant>" read against run.start. InputError,
-/// naming the file, the variable or attribute and what was expected, for anything else and
-/// for a time axis that does not cover [0, run.duration].
+/// y, x), each with its coordinate variable; x and y in m, or in a geographic scene longitude
+/// and latitude (degrees_east, degrees_north: FlowGridSpec::lon, lat), depth in m (positive
+/// down), time in "<unit> since <instant>" read against run.start. InputError, naming the
+/// file, the variable or attribute and what was expected, for anything else and for a time
+/// axis that does not cover [0, run.duration].
 FlowGridSpec inspect_flow_grid(const std::string& path, const std::string& u, const std::string& v,
-                               const RunSettings& run);
+                               const RunSettings& run, const GeoSpec& geo);
 
-/// The values of one time slice at a time, in m/s, layout [depth][y][x], NaN where the file
-/// holds a fill value.
+/// The values of one time slice at a time, in m/s, layout [depth][y][x] of the spec's x and y,
+/// NaN where the file holds a fill value. A grid on longitude and latitude is resampled onto
+/// the plane's lattice (FlowGridSpec::x, y): bilinear in longitude and latitude at each node,
+/// its east and north components turned onto the plane's axes there (NaN at a node off the
+/// file's grid).
 class NetcdfSlices {
  public:
   explicit NetcdfSlices(const FlowGridSpec& spec);
@@ -34,7 +39,16 @@ class NetcdfSlices {
     std::vector<double> fill;          // raw values that mean "no data"
   };
   void read_one(const Variable& var, std::size_t k, std::vector<double>& out) const;
+  /// A lattice node of a grid on longitude and latitude: the file's cell that holds it (i, j
+  /// of its lower-left corner; i < 0 off the grid), the weights within it, and the plane's unit
+  /// vectors of east and north there.
+  struct Node {
+    std::ptrdiff_t i = -1, j = -1;
+    double wx = 0.0, wy = 0.0;
+    Vec2 east, north;
+  };
   const FlowGridSpec& spec_;
+  std::vector<Node> nodes_;
   int ncid_ = -1;
   Variable u_, v_;
 };

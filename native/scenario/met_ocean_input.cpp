@@ -1,5 +1,6 @@
 #include "scenario/met_ocean_input.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -89,7 +90,7 @@ bool read_velocity_file(TableReader& env, std::string_view key, const Scene& sce
   const std::string name = path.string();
   if (extension == ".nc") {
     if (!std::filesystem::is_regular_file(path)) r.fail("file", "cannot open '" + name + "': no such file");
-    grid = inspect_flow_grid(name, u_name, v_name, scene.run);
+    grid = inspect_flow_grid(name, u_name, v_name, scene.run, scene.geo);
     return true;
   }
   std::ifstream in(name);
@@ -157,6 +158,85 @@ bool read_velocity_file(TableReader& env, std::string_view key, const Scene& sce
                                    }() + " s (run.duration: the series must cover the run)"));
   }
   return true;
+}
+
+namespace {
+
+/// A longitude moved by whole turns into [lo, hi] where it can be (a grid on 0 to 360 deg in a
+/// scene given in -180 to 180, or the other way round).
+double wrap_into(double lon, double lo, double hi) {
+  if (lon < lo && lon + 360.0 <= hi) return lon + 360.0;
+  if (lon > hi && lon - 360.0 >= lo) return lon - 360.0;
+  return lon;
+}
+
+}  // namespace
+
+void place_lonlat_grids(Scene& scene) {
+  for (FlowGridSpec* g : {&scene.environment.current_grid, &scene.environment.wind_grid}) {
+    if (g->empty() || !g->lonlat()) continue;
+    const GeoProjection projection(g->geo);
+    // Every moving body's outline inside the file's longitudes and latitudes.
+    Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+    for (const BodySpec& b : scene.bodies) {
+      if (b.fixed) continue;
+      for (const Vec2 p : b.polygon) {
+        const LonLat at = projection.to_lonlat(p);
+        const double lon = wrap_into(at.lon, g->lon.front(), g->lon.back());
+        if (!(lon >= g->lon.front() && lon <= g->lon.back() && at.lat >= g->lat.front() && at.lat <= g->lat.back())) {
+          std::ostringstream o;
+          o << "body '" << b.name << "' at longitude " << at.lon << ", latitude " << at.lat << " is off the grid, "
+            << "longitude [" << g->lon.front() << ", " << g->lon.back() << "], latitude [" << g->lat.front() << ", "
+            << g->lat.back() << "]; allowed a grid that holds every body";
+          throw InputError(input_message(g->file, 0, g->u, o.str()));
+        }
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+      }
+    }
+    if (lo.x > hi.x) lo = hi = Vec2{};  // no moving body: a lattice about the origin
+    // The grid's outline on the plane (its edges, 64 points each), and the lattice: the part of
+    // it within kMargin of the bodies, at half the file's finest spacing (a degree of latitude
+    // taken as 111.32 km, one of longitude as that times the cosine of the grid's highest
+    // latitude), coarsened until it holds at most kMaxNodes a level.
+    constexpr double kMargin = 200e3, kMetresPerDegree = 111.32e3;
+    constexpr std::size_t kMaxNodes = 1'000'000;
+    Vec2 flo{1e300, 1e300}, fhi{-1e300, -1e300};
+    auto take = [&](double lon, double lat) {
+      try {
+        const Vec2 p = projection.to_plane({lon, lat});
+        flo = {std::min(flo.x, p.x), std::min(flo.y, p.y)};
+        fhi = {std::max(fhi.x, p.x), std::max(fhi.y, p.y)};
+      } catch (const InputError&) {  // a corner beyond the projection's domain: not part of the outline
+      }
+    };
+    for (int k = 0; k <= 64; ++k) {
+      const double a = k / 64.0;
+      const double lon = g->lon.front() + a * (g->lon.back() - g->lon.front());
+      const double lat = g->lat.front() + a * (g->lat.back() - g->lat.front());
+      take(lon, g->lat.front());
+      take(lon, g->lat.back());
+      take(g->lon.front(), lat);
+      take(g->lon.back(), lat);
+    }
+    const Vec2 from{std::max(flo.x, lo.x - kMargin), std::max(flo.y, lo.y - kMargin)};
+    const Vec2 to{std::min(fhi.x, hi.x + kMargin), std::min(fhi.y, hi.y + kMargin)};
+    double dlon = 360.0, dlat = 180.0, top = 0.0;
+    for (std::size_t k = 1; k < g->lon.size(); ++k) dlon = std::min(dlon, g->lon[k] - g->lon[k - 1]);
+    for (std::size_t k = 1; k < g->lat.size(); ++k) dlat = std::min(dlat, g->lat[k] - g->lat[k - 1]);
+    for (const double lat : {g->lat.front(), g->lat.back()}) top = std::max(top, std::abs(lat));
+    double h = 0.5 * kMetresPerDegree * std::min(dlat, dlon * std::max(std::cos(top * M_PI / 180.0), 1e-3));
+    h = std::max(h, 50.0);
+    auto count = [&](double step) { return std::ceil((to.x - from.x) / step) + 1.0; };
+    while (count(h) * (std::ceil((to.y - from.y) / h) + 1.0) > static_cast<double>(kMaxNodes)) h *= 1.25;
+    g->spacing = h;
+    g->x.clear();
+    g->y.clear();
+    const auto nx = static_cast<std::size_t>(std::max(2.0, count(h)));
+    const auto ny = static_cast<std::size_t>(std::max(2.0, std::ceil((to.y - from.y) / h) + 1.0));
+    for (std::size_t i = 0; i < nx; ++i) g->x.push_back(from.x + static_cast<double>(i) * h);
+    for (std::size_t j = 0; j < ny; ++j) g->y.push_back(from.y + static_cast<double>(j) * h);
+  }
 }
 
 void check_grid_coverage(const Scene& scene) {

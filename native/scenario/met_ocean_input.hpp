@@ -23,6 +23,12 @@ void read_tides(TableReader& env_reader, Scene& scene);
 bool read_velocity_file(TableReader& env_reader, std::string_view key, const Scene& scene, VelocitySeries& series,
                         FlowGridSpec& grid);
 
+/// The plane's lattice of each grid on longitude and latitude (FlowGridSpec::lonlat): InputError
+/// when the grid does not hold every moving body's outline at t = 0; otherwise x and y become
+/// a lattice over the part of the grid within 200 km of the bodies, at half the grid's finest
+/// spacing (at most a million nodes a level), which each time slice is resampled onto.
+void place_lonlat_grids(Scene& scene);
+
 /// InputError when a grid of the scene does not hold every body's outline at t = 0.
 void check_grid_coverage(const Scene& scene);
 

@@ -589,6 +589,7 @@ Scene parse_scenario(const std::string& text, const std::string& path, const std
   read_bodies(root, scene, defaults.ice_density, defaults.floe, defaults.iceberg, geo.get());
   read_field(root, scene, defaults.ice_density, defaults.floe, geo.get());
   read_output(root, scene);  // after the bodies: [output] loads names them
+  place_lonlat_grids(scene);
   check_grid_coverage(scene);
   if (scene.bodies.empty()) root.fail("body", "no [[body]] and no [field] given; allowed at least one body");
   read_tow(root, scene, geo.get());

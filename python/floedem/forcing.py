@@ -42,11 +42,12 @@ def write_series(path, time, u, v, u_name="u", v_name="v"):
     os.replace(path + ".partial", path)
 
 
-def write_grid(path, x, y, time, u, v, start, depth=None, u_name="uo", v_name="vo", fill=None):
-    """A CF-NetCDF grid: x, y (m, the scene's frame), time (s from `start`, an instant in UTC
-    as "YYYY-MM-DDTHH:MM:SSZ"), optional depth (m, positive down); u and v in m/s, shaped
-    (time, y, x), or (time, depth, y, x) with a depth axis. NaN cells are written as the fill
-    value (`fill`, default -999)."""
+def write_grid(path, x, y, time, u, v, start, depth=None, u_name="uo", v_name="vo", fill=None, lonlat=False):
+    """A CF-NetCDF grid: x, y (m, the scene's frame; with lonlat=True longitude and latitude in
+    degrees, axes lon and lat, for a geographic scene, u and v then eastward and northward),
+    time (s from `start`, an instant in UTC as "YYYY-MM-DDTHH:MM:SSZ"), optional depth (m,
+    positive down); u and v in m/s, shaped (time, y, x), or (time, depth, y, x) with a depth
+    axis. NaN cells are written as the fill value (`fill`, default -999)."""
     import netCDF4
 
     x, y, t = _axis("x", x), _axis("y", y), _axis("time", time)
@@ -66,7 +67,7 @@ def write_grid(path, x, y, time, u, v, start, depth=None, u_name="uo", v_name="v
         dims = [("time", t, "seconds since " + start[:-1].replace("T", " "))]
         if z is not None:
             dims.append(("depth", z, "m"))
-        dims += [("y", y, "m"), ("x", x, "m")]
+        dims += [("lat", y, "degrees_north"), ("lon", x, "degrees_east")] if lonlat else [("y", y, "m"), ("x", x, "m")]
         for name, values, units in dims:
             nc.createDimension(name, values.size)
             var = nc.createVariable(name, "f8", (name,))

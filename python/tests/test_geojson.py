@@ -84,3 +84,25 @@ def test_the_command_writes_it_and_refuses_a_run_in_plain_metres(geo_run, tmp_pa
     r = subprocess.run([FLOEDEM, "export", str(tmp_path / "plain.h5"), "--geojson", "--xdmf"], capture_output=True,
                        text=True)
     assert r.returncode != 0
+
+
+def test_a_grid_on_longitude_and_latitude_drives_a_geographic_scene(tmp_path):
+    # A uniform eastward current on a lon/lat grid written by floedem.forcing: the berg at the
+    # origin drifts east, and `floedem check` tells the lattice the grid was resampled onto.
+    pytest.importorskip("netCDF4")
+    lon, lat = np.arange(30.0, 40.01, 0.5), np.arange(75.0, 79.01, 0.25)
+    t = np.array([-3600.0, 10800.0])
+    u = np.full((2, lat.size, lon.size), 0.3)
+    v = np.zeros_like(u)
+    floedem.forcing.write_grid(str(tmp_path / "ocean.nc"), lon, lat, t, u, v, start="2009-05-15T00:00:00Z", lonlat=True)
+    scene = SCENE.replace("[environment]\nwind = [12.0, 4.0]",
+                          "[environment]\n[environment.current_file]\nfile = \"ocean.nc\"\nu = \"uo\"\nv = \"vo\"")
+    scene = scene.replace("[run]\n", "[run]\nstart = \"2009-05-15T00:00:00Z\"\n")
+    (tmp_path / "grid.toml").write_text(scene)
+    r = subprocess.run([FLOEDEM, "check", str(tmp_path / "grid.toml")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "resampled every" in r.stdout and "longitude [30" in r.stdout
+    subprocess.run([FLOEDEM, "run", str(tmp_path / "grid.toml"), "-o", str(tmp_path / "grid.h5"), "-q"], check=True)
+    with floedem.open(str(tmp_path / "grid.h5")) as run:
+        moved = run.lonlat[-1, 0] - run.lonlat[0, 0]
+        assert moved[0] > 0.005 and abs(moved[1]) < moved[0] * np.cos(np.radians(77.0))

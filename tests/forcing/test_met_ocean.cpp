@@ -13,6 +13,8 @@
 #include <functional>
 #include <sstream>
 
+#include "floedem/scene/geo.hpp"
+#include "forcing/flow_grid.hpp"
 #include "forcing/forcing.hpp"
 #include "run/stepper.hpp"
 #include "floedem/scenario/scenario.hpp"
@@ -296,6 +298,7 @@ struct GridFile {
   std::vector<double> depth;       // m; empty: (time, y, x)
   std::function<Vec2(double t, double x, double y, double depth)> field;
   std::string velocity_units = "m s-1", x_units = "m", time_units = "hours since 2024-03-01 00:00:00";
+  std::string y_units;  // empty: x_units
   bool fill_somewhere = false;  // the first cell of every slice holds the fill value
 };
 
@@ -312,7 +315,7 @@ void write_grid(const std::filesystem::path& path, const GridFile& g) {
   const auto t = dim("time", g.time, g.time_units);
   const bool z = !g.depth.empty();
   const auto d = z ? dim("depth", g.depth, "m") : std::pair{-1, -1};
-  const auto y = dim("y", g.y, g.x_units);
+  const auto y = dim("y", g.y, g.y_units.empty() ? g.x_units : g.y_units);
   const auto x = dim("x", g.x, g.x_units);
   std::vector<int> dims = {t.first};
   if (z) dims.push_back(d.first);
@@ -540,4 +543,61 @@ TEST_CASE("a gridded current with a depth axis feeds each keel layer the current
   b.evaluate(st, 0.0);
   CHECK(a.environment_force(0)[0] > 0.0);
   CHECK(a.environment_force(0) == b.environment_force(0));
+}
+
+TEST_CASE("a current on longitude and latitude is the plane's field in a geographic scene", "[met_ocean][geo]") {
+  // A field linear in longitude and latitude (so bilinear in them exactly), eastward and
+  // northward, about a scene at (20 E, 70 N). Resampled onto the plane's lattice (4.5 km here:
+  // half the grid's 9 km of longitude at 71 N) and read there, it must be, at any point, the
+  // field at that point's longitude and latitude, its east and north turned onto the plane's
+  // axes there: the meridians converge by 2.5 deg 100 km east of the origin. The lattice's
+  // bilinear error: the curvature of latitude over a cell, h^2 tan(lat) / (8 R^2) = 1.7e-7 rad,
+  // times 0.05 m/s per degree, 5e-7 m/s.
+  const std::filesystem::path dir = test::temp_dir("grid-lonlat");
+  auto east = [](double lon, double lat) { return 0.2 + 0.05 * (lat - 70.0) + 0.01 * (lon - 20.0); };
+  auto north = [](double lon, double) { return 0.1 - 0.02 * (lon - 20.0); };
+  GridFile g;
+  for (double lon = 16.0; lon <= 24.0 + 1e-9; lon += 0.25) g.x.push_back(lon);
+  for (double lat = 69.0; lat <= 71.0 + 1e-9; lat += 0.1) g.y.push_back(lat);
+  g.time = {-1.0, 2.0};
+  g.x_units = "degrees_east";
+  g.y_units = "degrees_north";
+  g.field = [&](double, double lon, double lat, double) { return Vec2{east(lon, lat), north(lon, lat)}; };
+  write_grid(dir / "ocean.nc", g);
+  const std::string body = "[[body]]\nname = \"a\"\nthickness = 1.0\n"
+                           "polygon = [[-50.0, -50.0], [50.0, -50.0], [50.0, 50.0], [-50.0, 50.0]]\n";
+  const std::string head = std::string(kStart) + "duration = 3600.0\ndt = 10.0\n[geo]\norigin = [20.0, 70.0]\n"
+                                                 "[environment]\n" + grid_table(dir / "ocean.nc");
+  const Scene s = test::scene_from(head + body);
+  const FlowGridSpec& spec = s.environment.current_grid;
+  REQUIRE(spec.lonlat());
+  CHECK(spec.spacing == Approx(0.5 * 111.32e3 * 0.25 * std::cos(71.0 * M_PI / 180.0)).epsilon(1e-9));
+  CHECK(spec.x.front() < -150e3);  // 200 km about the floe, within the grid's outline
+  CHECK(spec.x.back() > 150e3);
+  FlowGrid grid(spec);
+  grid.prepare(0.0);
+  const GeoProjection projection(s.geo);
+  double worst = 0.0, turn = 0.0;
+  for (const Vec2 p : {Vec2{0.0, 0.0}, Vec2{100e3, 0.0}, Vec2{-80e3, 60e3}, Vec2{37e3, -91e3}, Vec2{120e3, 80e3}}) {
+    const LonLat at = projection.to_lonlat(p);
+    const Vec2 e = normalized(projection.to_plane({at.lon + 1e-4, at.lat}) - projection.to_plane({at.lon - 1e-4, at.lat}));
+    const Vec2 n = normalized(projection.to_plane({at.lon, at.lat + 1e-4}) - projection.to_plane({at.lon, at.lat - 1e-4}));
+    const Vec2 expected = east(at.lon, at.lat) * e + north(at.lon, at.lat) * n;
+    worst = std::max(worst, length(grid.at(p, 0.0) - expected));
+    turn = std::max(turn, std::abs(std::atan2(e.y, e.x)));
+  }
+  CHECK(worst < 2e-6);
+  CHECK(turn > 0.04);  // the turn of east is there to be taken: 2.3 deg and more
+  // A body off the file's longitudes and latitudes is refused by name when the scenario is read.
+  try {
+    (void)test::scene_from(head + "[[body]]\nname = \"far\"\nthickness = 1.0\nposition_lonlat = [30.0, 70.0]\n"
+                                  "polygon = [[-50.0, -50.0], [50.0, -50.0], [50.0, 50.0], [-50.0, 50.0]]\n");
+    FAIL("accepted");
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    INFO(m);
+    CHECK(m.find("ocean.nc") != std::string::npos);
+    CHECK(m.find("body 'far'") != std::string::npos);
+    CHECK(m.find("longitude [16, 24]") != std::string::npos);
+  }
 }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "floedem/geometry/vec2.hpp"
+#include "floedem/scene/geo.hpp"
 
 namespace floedem {
 
@@ -52,7 +53,15 @@ struct FlowGridSpec {
   std::vector<double> x, y;    ///< m, the scene's axes, increasing
   std::vector<double> depth;   ///< m below the surface, increasing; empty: no depth axis
   std::vector<double> time;    ///< s from the run's start, increasing
+  /// A grid on longitude and latitude (a geographic scene's; docs/geography.md): the file's own
+  /// axes, deg, increasing. x and y are then a lattice of the scene's plane, `spacing` apart,
+  /// onto which each time slice is resampled as it is read (its east and north components
+  /// turned into the plane's axes), and `geo` the scene's projection.
+  std::vector<double> lon, lat;
+  double spacing = 0.0;  ///< m
+  GeoSpec geo;
   bool empty() const { return file.empty(); }
+  bool lonlat() const { return !lon.empty(); }
 };
 
 }  // namespace floedem
