@@ -51,7 +51,7 @@ std::string inertial_scene(const std::string& geo_or_latitude, const std::string
 }
 
 /// The angle (rad, unwrapped) the velocity of `body` has turned through over the run.
-double turned(const Scene& s, std::size_t body) {
+double turned_angle(const Scene& s, std::size_t body) {
   Stepper run(s, "native");
   double total = 0.0;
   Vec2 before = run.state().velocity[body];
@@ -147,7 +147,7 @@ TEST_CASE("geo: each body turns at its own latitude's Coriolis parameter", "[geo
   const Scene geo = test::scene_from(inertial_scene("[geo]\norigin = [20.0, 70.0]\n[environment]\n", floes));
   REQUIRE(geo.environment.coriolis);
   const double t = geo.run.duration - 0.5 * geo.run.dt;
-  const double south = turned(geo, 0), north = turned(geo, 1);
+  const double south = turned_angle(geo, 0), north = turned_angle(geo, 1);
   CHECK(-south / t == Approx(coriolis_parameter(66.4)).epsilon(2.5e-4));
   CHECK(-north / t == Approx(coriolis_parameter(79.0)).epsilon(2.5e-4));
   for (const auto& [lat, angle] : {std::pair{66.4, south}, std::pair{79.0, north}}) {
@@ -156,7 +156,7 @@ TEST_CASE("geo: each body turns at its own latitude's Coriolis parameter", "[geo
     at << "[environment]\nlatitude = " << lat << "\n";
     const Scene plain = test::scene_from(
         inertial_scene(at.str(), "[[body]]\nname = \"f\"\nthickness = 1.0\nvelocity = [0.2, 0.0]\n" + square));
-    CHECK(angle == Approx(turned(plain, 0)).epsilon(2.5e-4));
+    CHECK(angle == Approx(turned_angle(plain, 0)).epsilon(2.5e-4));
   }
 }
 
