@@ -1,6 +1,6 @@
-"""Writes the forcing files of hindcast.toml beside it, from formulas (no download): the role a
-model extract and a weather record play in a real hindcast (docs/forcing.md, "A hindcast from
-end to end").
+"""Writes the forcing files and the ice chart of hindcast.toml beside it, from formulas (no
+download): the role a model extract, a weather record and an ice service's chart play in a real
+hindcast (docs/forcing.md, "A hindcast from end to end").
 
     /usr/bin/python3 make_forcing.py [DIR]      # DIR: where to write them (default: here)
 
@@ -9,6 +9,9 @@ ocean.nc  a current on longitude and latitude (CF-NetCDF), hourly over the run a
           tidal ellipse whose phase advances eastward, as a tide propagating along the shelf.
 wind.csv  a wind record every 30 min: a westerly that freshens to a 15 m/s gale at 12 h and
           backs to the south-west as it eases.
+chart.geojson  an ice chart in SIGRID-3 codes (docs/ice_charts.md): west of 45 E close ice
+          (7-9/10) of medium first-year small floes; east of it open ice (4-6/10) of thin
+          first-year small floes, with an open lead (less than 1/10) along its north.
 """
 import math
 import os
@@ -20,6 +23,14 @@ import floedem
 
 START = "2009-05-15T00:00:00Z"   # hindcast.toml's [run] start
 M2 = 44714.16                    # s, the M2 period (docs/forcing.md)
+
+
+# The chart's polygons (lon, lat), tiling 44.9 to 45.1 E, 79.49 to 79.51 N about the iceberg.
+CHART = [
+    {"lonlat": [(44.9, 79.49), (45.0, 79.49), (45.0, 79.51), (44.9, 79.51)], "CT": "79", "SA": "91", "FA": "03"},
+    {"lonlat": [(45.0, 79.49), (45.1, 79.49), (45.1, 79.5025), (45.0, 79.5025)], "CT": "46", "SA": "87", "FA": "03"},
+    {"lonlat": [(45.0, 79.5025), (45.1, 79.5025), (45.1, 79.51), (45.0, 79.51)], "CT": "01"},
+]
 
 
 def current(t, lon, lat):
@@ -50,6 +61,7 @@ def main(out):
     speed = 6.0 + 9.0 * gale
     floedem.forcing.write_series(os.path.join(out, "wind.csv"), wt, speed * np.cos(direction),
                                  speed * np.sin(direction))
+    floedem.chart.write_chart(os.path.join(out, "chart.geojson"), CHART)
     return out
 
 

@@ -122,6 +122,36 @@ struct ReportCommand {
 
 // `floedem check`: the scenario loaded, overrides applied and each engine built, as a run would,
 // and nothing run (a sweep checks every point with it before it starts).
+/// `floedem check`'s lines for a field from an ice chart: each polygon's codes, what they gave
+/// the generator and what it made (the /field provenance the output will hold).
+void print_chart(const floedem::Scene& scene) {
+  auto number = [](const floedem::Provenance& p, const std::string& key) {
+    for (const auto& [k, v] : p.numbers)
+      if (k == key) return v;
+    return 0.0;
+  };
+  auto text = [](const floedem::Provenance& p, const std::string& key) {
+    for (const auto& [k, v] : p.text)
+      if (k == key) return v;
+    return std::string();
+  };
+  for (const floedem::Provenance& p : scene.provenance) {
+    if (p.group == "/field" && !text(p, "chart").empty())
+      std::cout << "  chart " << text(p, "chart") << ", layer '" << text(p, "layer") << "': " << number(p, "polygons")
+                << " polygons, " << number(p, "floes") << " floes, concentration " << number(p, "concentration_achieved")
+                << " of the free area in the field's rectangle\n";
+    if (!p.group.starts_with("/field/chart_feature_")) continue;
+    std::cout << "    feature " << number(p, "fid") << ": CT " << number(p, "CT") << " (C " << number(p, "concentration") << ")";
+    if (number(p, "floes") > 0.0 || number(p, "concentration") > 0.0)
+      std::cout << ", SA " << number(p, "SA") << " (" << number(p, "thickness_min") << " to " << number(p, "thickness_max")
+                << " m), FA " << number(p, "FA") << " (" << number(p, "d_min") << " to " << number(p, "d_max_used") << " m)";
+    std::cout << "; " << number(p, "area") << " m^2 in the rectangle, " << number(p, "floes") << " floes, C "
+              << number(p, "concentration_achieved") << " of its free area";
+    if (number(p, "pieces_too_small") > 0.0) std::cout << ", " << number(p, "pieces_too_small") << " pieces too small for a floe";
+    std::cout << "\n";
+  }
+}
+
 struct CheckCommand {
   std::string scenario;
   std::vector<std::string> overrides, engines;
@@ -176,6 +206,7 @@ struct CheckCommand {
                 << scene.geo.projection << "\"; bodies over longitude [" << lon[0] << ", " << lon[1] << "], latitude ["
                 << lat[0] << ", " << lat[1] << "]" << (env.coriolis ? "; Coriolis at each body's latitude" : "") << "\n";
     }
+    print_chart(scene);
     for (const floedem::TidalConstituent& c : env.tides)
       std::cout << "  tide " << (c.name.empty() ? "period " + std::to_string(c.period) + " s" : c.name) << ": major "
                 << c.major << " m/s, minor " << c.minor << " m/s\n";

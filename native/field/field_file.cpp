@@ -1,5 +1,6 @@
 #include "floedem/field/field_file.hpp"
 
+#include <filesystem>
 #include <sstream>
 
 #include "floedem/engine/engine.hpp"
@@ -61,6 +62,60 @@ Provenance field_provenance(const Field& field, const FieldSpec& spec, double de
            {"max_cell_area_error", st.max_cell_area_error},
            {"floes_short_of_area", static_cast<double>(st.floes_short_of_area)},
            {"floes_dropped_below_d_min", static_cast<double>(st.floes_dropped_below_d_min)}}};
+}
+
+std::vector<Provenance> chart_provenance(const Field& field, const IceChart& chart, const std::vector<ChartPolygonStats>& stats,
+                                         const FieldSpec& spec, double density, std::size_t first_floe) {
+  std::vector<Provenance> out;
+  out.push_back({"/field",
+                 {{"method", "ice chart: each polygon's part inside the rectangle, free of bodies and keep-out zones, filled "
+                             "by the generator with the concentration, floe sizes and thickness of its SIGRID-3 codes"},
+                  {"chart", std::filesystem::path(chart.path).filename().string()},
+                  {"layer", chart.layer},
+                  {"seed", std::to_string(spec.seed)}},
+                 {{"origin_x", spec.origin.x},
+                  {"origin_y", spec.origin.y},
+                  {"width", spec.width},
+                  {"height", spec.height},
+                  {"alpha", spec.alpha},
+                  {"irregularity", spec.irregularity},
+                  {"density", density},
+                  {"polygons", static_cast<double>(chart.polygons.size())},
+                  {"floes", static_cast<double>(field.stats.floes)},
+                  {"first_floe", static_cast<double>(first_floe)},
+                  {"free_area", field.stats.free_area},
+                  {"ice_area", field.stats.ice_area},
+                  {"concentration_achieved", field.stats.concentration},
+                  {"newton_iterations", static_cast<double>(field.stats.newton_iterations)},
+                  {"max_cell_area_error", field.stats.max_cell_area_error},
+                  {"floes_short_of_area", static_cast<double>(field.stats.floes_short_of_area)},
+                  {"floes_dropped_below_d_min", static_cast<double>(field.stats.floes_dropped_below_d_min)}}});
+  for (std::size_t i = 0; i < stats.size(); ++i) {
+    const ChartPolygon& p = chart.polygons[i];
+    const ChartPolygonStats& st = stats[i];
+    out.push_back({"/field/chart_feature_" + std::to_string(p.fid),
+                   {},
+                   {{"fid", static_cast<double>(p.fid)},
+                    {"CT", static_cast<double>(p.ct)},
+                    {"SA", static_cast<double>(p.sa)},
+                    {"FA", static_cast<double>(p.fa)},
+                    {"concentration", p.concentration},
+                    {"d_min", p.d_min},
+                    {"d_max", p.d_max},
+                    {"d_max_used", st.d_max_used},
+                    {"thickness_min", p.thickness_min},
+                    {"thickness_max", p.thickness_max},
+                    {"area", st.area},
+                    {"free_area", st.free_area},
+                    {"ice_area", st.ice_area},
+                    {"concentration_achieved", st.free_area > 0.0 ? st.ice_area / st.free_area : 0.0},
+                    {"floes", static_cast<double>(st.floes)},
+                    {"pieces", static_cast<double>(st.pieces)},
+                    {"pieces_too_small", static_cast<double>(st.pieces_too_small)},
+                    {"alpha_fitted", st.fit.alpha},
+                    {"alpha_fitted_stderr", st.fit.stderr_alpha}}});
+  }
+  return out;
 }
 
 void write_field_file(const std::string& path, const Field& field, const FieldSpec& spec, double density,

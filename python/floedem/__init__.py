@@ -10,6 +10,7 @@
     floedem.stats.stationary_window(...), floedem.stats.block_standard_error(...)
     floedem.forcing.write_grid(...), floedem.forcing.write_series(...)   # forcing files
     floedem.geojson.export("drift.h5")   # a geographic scene's run for QGIS
+    floedem.chart.write_chart(...), floedem.chart.polygons(run)   # ice charts
 
 Files of another layout (format_version) or damaged ones raise floedem.FileError naming the
 file, the dataset and what was expected. The layout is docs/output.md of the repository.
@@ -20,7 +21,7 @@ from .errors import FileError  # noqa: F401
 
 # numpy and h5py load on the first use of what needs them (PEP 562), not at `import floedem`:
 # the workflow runs `python3 -m floedem launch-one` once per job, hundreds of times a report.
-_LAZY = {"open": "run", "Run": "run", "FORMAT_VERSION": "run", "stats": None, "forcing": None, "geojson": None}
+_LAZY = {"open": "run", "Run": "run", "FORMAT_VERSION": "run", "stats": None, "forcing": None, "geojson": None, "chart": None}
 
 
 def __getattr__(name):
@@ -37,4 +38,4 @@ def __dir__():
 
 
 __version__ = "0.1.0"
-__all__ = ["open", "Run", "FileError", "FORMAT_VERSION", "stats", "forcing", "geojson", "__version__"]
+__all__ = ["open", "Run", "FileError", "FORMAT_VERSION", "stats", "forcing", "geojson", "chart", "__version__"]
