@@ -34,6 +34,9 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/reports/ DESTINATION ${FLOEDEM_DATA_DIR}
   PATTERN "threads-*" EXCLUDE PATTERN "anchors" EXCLUDE PATTERN "tests" EXCLUDE PATTERN "__pycache__" EXCLUDE)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenarios/ DESTINATION ${FLOEDEM_DATA_DIR}/scenarios)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/profiles/ DESTINATION ${FLOEDEM_DATA_DIR}/profiles)
+# The hindcast example: the report's hindcast section runs it as a user would.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/hindcast DESTINATION ${FLOEDEM_DATA_DIR}/examples
+  FILES_MATCHING PATTERN "*.py" PATTERN "*.toml")
 # The Python package: beside the command (which runs `python3 -m floedem` from there), with its
 # pyproject.toml (pip install PREFIX/share/floedem/python), and where the Python that found
 # numpy and h5py looks for packages of this prefix (cmake/python_site.py), so that
@@ -53,6 +56,6 @@ endif()
 
 # The build tree's share/floedem: links to the sources, so that an edited script is the one run.
 file(MAKE_DIRECTORY ${PROJECT_BINARY_DIR}/share/floedem)
-foreach(_dir IN ITEMS reports scenarios python)
+foreach(_dir IN ITEMS reports scenarios python examples)
   file(CREATE_LINK ${PROJECT_SOURCE_DIR}/${_dir} ${PROJECT_BINARY_DIR}/share/floedem/${_dir} SYMBOLIC)
 endforeach()

@@ -35,6 +35,16 @@ def _to_lonlat(geo):
     return to_lonlat
 
 
+def lonlat_polygons(run, frame=-1):
+    """The bodies' polygons at a frame of an open geographic run, in longitude and latitude:
+    [k, 2] arrays, as run.polygons(frame) gives them in the plane."""
+    if run.geo is None:
+        raise FileError(f"{run.path}: /geo: missing; only a geographic scene's run ([geo] in its scenario, "
+                        "docs/geography.md) has longitudes and latitudes")
+    to_lonlat = _to_lonlat(run.geo)
+    return [to_lonlat(np.asarray(p)) for p in run.polygons(frame)]
+
+
 def _finite(rows):
     """Coordinates as lists of [lon, lat] with 9 decimals (0.1 mm), rows that are not finite left out."""
     return [[round(float(a), 9), round(float(b), 9)] for a, b in rows if math.isfinite(a) and math.isfinite(b)]
@@ -59,11 +69,10 @@ def features(run):
         out.append({"type": "Feature", "geometry": geometry,
                     "properties": {"name": str(name), "layer": "track", "start_time": float(run.time[0]),
                                    "end_time": float(run.time[-1])}})
-    to_lonlat = _to_lonlat(run.geo)
     speed = np.linalg.norm(run.velocity[-1], axis=1)
     thickness, fixed = run.bodies.thickness, run.bodies.fixed
-    for i, polygon in enumerate(run.polygons(-1)):
-        ring = _finite(to_lonlat(np.asarray(polygon)))
+    for i, polygon in enumerate(lonlat_polygons(run, -1)):
+        ring = _finite(polygon)
         if len(ring) < 3:
             continue
         ring.append(ring[0])  # RFC 7946 3.1.6: a closed ring, counter-clockwise outside

@@ -10,7 +10,7 @@ _PYTHON = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.r
 if _PYTHON not in sys.path:
     sys.path.insert(0, _PYTHON)
 
-from sections import (channel, cost_error, engines, field, impacts, observations, speed, stress, threads,  # noqa: E402
-                      towing)
+from sections import (channel, cost_error, engines, field, hindcast, impacts, observations, speed, stress,  # noqa: E402
+                      threads, towing)
 
-SECTIONS = [impacts, towing, field, channel, observations, stress, speed, threads, cost_error, engines]
+SECTIONS = [impacts, towing, field, channel, hindcast, observations, stress, speed, threads, cost_error, engines]
