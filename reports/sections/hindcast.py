@@ -18,7 +18,7 @@ from report_runner import Run
 HERE = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
 EXAMPLE = os.path.join(os.path.dirname(HERE), "examples", "hindcast")
 SEEDS = {True: 2, False: 8}                  # field seeds: quick, full
-DURATION = {True: 7200.0, False: 86400.0}    # s
+DURATION = {True: 3600.0, False: 86400.0}    # s
 BASE_SEED = 2009                             # hindcast.toml's run.seed
 # A chart polygon's achieved concentration against its code's: the generator fills a cell to
 # 1e-6 of its target, and cells cut where a polygon's outline is concave lose up to a few per

@@ -9,6 +9,13 @@ conditions form a range, and the verdict is "overlaps" when the two ranges share
 count as a pass. Otherwise "outside", with the factor (or the difference, for angles) to the
 nearest end of the observed range.
 
+A case whose outcome depends on the field (the drifts, the pack against the shore, the
+iceberg's rotation) runs over field seeds (SEEDS), and its verdict is on the 95 % interval of
+the ensemble mean: "inside" when the whole interval lies in the observed range, "overlaps" when
+part of it does, "outside" by the factor from the interval's nearest end. A verdict that another
+set of as many seeds would likely change (fewer than 90 % of bootstrap resamples of the seeds
+give it) is marked unsettled.
+
 A miss is a result, not a failure: the report fails only on a regression, a row recorded as
 passing in the committed verdicts (reports/observations_verdicts_quick.json for --quick,
 reports/observations_verdicts_full.json for the full report) that fails now. A row that passes
@@ -38,6 +45,11 @@ COMPLIANT = ["ode", "bullet"]
 # docs/model.md 4 against the default 1.5e-4.
 WATER_FORM = [0.5, 1.5]
 C_TAUS = [1.3e-4, 5e-4]
+# Field seeds of the cases whose outcome depends on the field: the full report's and the quick
+# one's. Seed k runs with the scene's own run.seed + k (k = 0 keeps the scene's file as it is).
+SEEDS = {False: 8, True: 2}
+# A verdict holds when at least this share of bootstrap resamples of the seeds gives it.
+SETTLED = 0.9
 # The observed ranges (docs/validation.md gives each source in full).
 OBS = {
     "floe_factor": (0.016, 0.023), "floe_deflection": (-6.0, 9.0),
@@ -117,6 +129,21 @@ def scenario(ctx, name):
     return os.path.join(ctx.scenarios, "observations", name + ".toml")
 
 
+def seeded(tag, k):
+    """The tag of seed k of an ensemble (seed 0 keeps the plain tag the text and figures read)."""
+    return tag if k == 0 else f"{tag}_s{k}"
+
+
+def seed_set(path, k):
+    """--set for seed k of a scene: its own run.seed + k (none for k = 0)."""
+    if k == 0:
+        return []
+    import tomllib
+    with open(path, "rb") as f:
+        base = tomllib.load(f)["run"]["seed"]
+    return [f"run.seed={base + k}"]
+
+
 def square(side, x0, y0=0.0):
     """A square of side `side` (m) from x0 along +x, centred on y0, as a --set polygon."""
     h = 0.5 * side
@@ -146,13 +173,16 @@ def plan(ctx):
     drift = scenario(ctx, "wind_drift_barents")
     n_floes = 1900 if not ctx.quick else 700
     steps = 21600 if not ctx.quick else 5400
-    runs.append(Run("obs_drift", drift, "native", list(c["drift"]), cost=steps * n_floes * 3e-6,
-                    meta=dict(part="drift", water_form=0.9)))
+    for k in range(SEEDS[ctx.quick]):
+        runs.append(Run(seeded("obs_drift", k), drift, "native", list(c["drift"]) + seed_set(drift, k),
+                        cost=steps * n_floes * 3e-6, meta=dict(part="drift", water_form=0.9, seed=k)))
     for cw in WATER_FORM:
         runs.append(Run(f"obs_drift_cw{cw:g}", drift, "native", c["drift"] + [f"environment.drag.water_form={cw!r}"],
                         cost=steps * n_floes * 3e-6, meta=dict(part="drift", water_form=cw)))
-    runs.append(Run("obs_compaction", scenario(ctx, "compaction_gulf"), "native", list(c["compaction"]), cost=30.0,
-                    meta=dict(part="compaction")))
+    gulf = scenario(ctx, "compaction_gulf")
+    for k in range(SEEDS[ctx.quick]):
+        runs.append(Run(seeded("obs_compaction", k), gulf, "native", list(c["compaction"]) + seed_set(gulf, k),
+                        cost=30.0, meta=dict(part="compaction", seed=k)))
     engines = [e for e in ["native"] + COMPLIANT if e in ctx.engines]
     # Weber: two equal square floes 3 m thick, face to face at 0.05 m/s (m_eff = m / 2).
     for d, _ in WEBER_SIDES.items():
@@ -304,6 +334,41 @@ def passes(v):
     return v in ("inside", "overlaps")
 
 
+_T975 = {}
+
+
+def interval(values):
+    """Mean, half-width of its 95 % interval (Student's t over the seeds), standard deviation."""
+    from floedem import tdist
+    v = np.asarray(values, float)
+    n = len(v)
+    if n > 1 and n not in _T975:
+        _T975[n] = tdist.ppf(0.975, n - 1)
+    sd = float(v.std(ddof=1)) if n > 1 else 0.0
+    half = _T975[n] * sd / math.sqrt(n) if n > 1 else 0.0
+    return float(v.mean()), half, sd
+
+
+def ensemble_verdict(values, obs, angle=False, floor=None):
+    """(verdict, how far, share of bootstrap resamples that give the same verdict) for the 95 %
+    interval of the mean of `values` (one per seed) against the observed (lo, hi), the interval
+    cut at `floor` for a quantity that cannot lie below it (a speed ratio, an angular speed's
+    magnitude: 0). The resamples (2000, drawn with replacement, a fixed stream) stand for other
+    sets of as many seeds."""
+    def span(vals):
+        m, half, _ = interval(vals)
+        lo = m - half if floor is None else max(m - half, floor)
+        return lo, m + half
+    v, how = verdict(span(values), obs, angle)
+    rng = np.random.default_rng(20091)
+    vals = np.asarray(values, float)
+    same = 0
+    trials = 2000
+    for _ in range(trials):
+        same += verdict(span(rng.choice(vals, size=len(vals), replace=True)), obs, angle)[0] == v
+    return v, how, same / trials
+
+
 def verdicts_name(quick):
     """The file of committed verdicts of one kind of report, in reports/: {row id: "pass" | "miss"}."""
     return f"observations_verdicts_{'quick' if quick else 'full'}.json"
@@ -359,25 +424,41 @@ def write(ctx):
     def row(rid, case, quantity, sim, sim_text, key, engine="native", angle=False):
         v, how = verdict(sim, OBS[key], angle)
         rows.append(dict(id=rid, case=case, quantity=quantity, observed=OBS_TEXT[key], simulated=sim_text,
-                         verdict=v, how=how, engine=engine))
+                         verdict=v, how=how, engine=engine, settled=1.0))
 
-    # Case 1: wind drift.
-    drift = read_drift(ctx.run("obs_drift"), c["drift_window"])
+    n_seeds = SEEDS[ctx.quick]
+
+    def ensemble_row(rid, case, quantity, values, form, key, angle=False):
+        """A row over the seeds: the mean with the half-width of its 95 % interval and the
+        seed-to-seed standard deviation; the verdict on the interval (cut at 0 for the
+        magnitudes: every quantity but an angle)."""
+        m, half, sd = interval(values)
+        v, how, settled = ensemble_verdict(values, OBS[key], angle, floor=None if angle else 0.0)
+        text = f"{form(m)} +- {half:.2g} (std {sd:.2g}, {len(values)} seeds)"
+        rows.append(dict(id=rid, case=case, quantity=quantity, observed=OBS_TEXT[key], simulated=text,
+                         verdict=v, how=how, engine="native", settled=settled))
+
+    # Case 1: wind drift, over the field seeds.
+    drifts = [read_drift(ctx.run(seeded("obs_drift", k)), c["drift_window"]) for k in range(n_seeds)]
+    drift = drifts[0]
     sens = {cw: read_drift(ctx.run(f"obs_drift_cw{cw:g}"), c["drift_window"]) for cw in WATER_FORM}
     sens[0.9] = drift
     fl, fd = drift["floes"]
     bf, bd = drift["berg"]
-    row("drift_floe_factor", "1 Barents Sea drift", "floes: wind factor", fl, f"{fl:.4f}", "floe_factor")
-    row("drift_floe_deflection", "1 Barents Sea drift", "floes: deflection (deg)", fd, f"{fd:+.1f}",
-        "floe_deflection", angle=True)
-    row("drift_berg_factor", "1 Barents Sea drift", "iceberg: wind factor", bf, f"{bf:.4f}", "berg_factor")
-    row("drift_berg_deflection", "1 Barents Sea drift", "iceberg: deflection (deg)", bd, f"{bd:+.1f}",
-        "berg_deflection", angle=True)
-    comp = read_compaction(ctx.run("obs_compaction"), c["compacted_window"])
-    row("compaction_free", "1 Gulf of St Lawrence", "pack, free: wind factor", comp["free"],
-        f"{comp['free']:.4f}", "free_factor")
-    row("compaction_arrest", "1 Gulf of St Lawrence", "pack against the shore: wind factor", comp["compacted"],
-        f"{comp['compacted']:.2g}", "compacted_factor")
+    ensemble_row("drift_floe_factor", "1 Barents Sea drift", "floes: wind factor", [d["floes"][0] for d in drifts],
+                 lambda x: f"{x:.4f}", "floe_factor")
+    ensemble_row("drift_floe_deflection", "1 Barents Sea drift", "floes: deflection (deg)",
+                 [d["floes"][1] for d in drifts], lambda x: f"{x:+.1f}", "floe_deflection", angle=True)
+    ensemble_row("drift_berg_factor", "1 Barents Sea drift", "iceberg: wind factor", [d["berg"][0] for d in drifts],
+                 lambda x: f"{x:.4f}", "berg_factor")
+    ensemble_row("drift_berg_deflection", "1 Barents Sea drift", "iceberg: deflection (deg)",
+                 [d["berg"][1] for d in drifts], lambda x: f"{x:+.1f}", "berg_deflection", angle=True)
+    comps = [read_compaction(ctx.run(seeded("obs_compaction", k)), c["compacted_window"]) for k in range(n_seeds)]
+    comp = comps[0]
+    ensemble_row("compaction_free", "1 Gulf of St Lawrence", "pack, free: wind factor", [x["free"] for x in comps],
+                 lambda x: f"{x:.4f}", "free_factor")
+    ensemble_row("compaction_arrest", "1 Gulf of St Lawrence", "pack against the shore: wind factor",
+                 [x["compacted"] for x in comps], lambda x: f"{x:.2g}", "compacted_factor")
 
     # Case 2: collisions.
     col = {}
@@ -404,10 +485,10 @@ def write(ctx):
         si(tow_range, 1e3), "tow_force")
 
     # Case 4: rotation of the drifting iceberg of case 1.
-    row("rotation_mean", "4 iceberg rotation", "iceberg: mean abs(omega) (rad/s)", drift["omega_mean"],
-        f"{drift['omega_mean']:.2g}", "omega_mean")
-    row("rotation_max", "4 iceberg rotation", "iceberg: largest abs(omega) (rad/s)", drift["omega_max"],
-        f"{drift['omega_max']:.2g}", "omega_max")
+    ensemble_row("rotation_mean", "4 iceberg rotation", "iceberg: mean abs(omega) (rad/s)",
+                 [d["omega_mean"] for d in drifts], lambda x: f"{x:.2g}", "omega_mean")
+    ensemble_row("rotation_max", "4 iceberg rotation", "iceberg: largest abs(omega) (rad/s)",
+                 [d["omega_max"] for d in drifts], lambda x: f"{x:.2g}", "omega_max")
 
     # Regressions against the committed verdicts.
     fails, newly = regressions(rows, load_verdicts(ctx.quick))
@@ -424,9 +505,18 @@ def write(ctx):
           "outcomes is not published, the simulated figures at the corners of those conditions form a range that "
           "passes when it *overlaps* the observed one. A miss is reported with its factor and its likely cause; "
           f"the report fails only when a row that passed (`reports/{verdicts_name(ctx.quick)}`) stops passing.", "",
+          f"A case whose outcome depends on the field runs over {n_seeds} field seeds (the scene's run.seed and the "
+          f"next {n_seeds - 1}): its row gives the mean over the seeds with the half-width of its 95 % interval "
+          "(Student's t) and the seed-to-seed standard deviation, and its verdict is on that interval: inside when "
+          "the whole interval lies in the observed range, overlaps when part of it does, outside by the factor (or "
+          "the difference) from the interval's nearest end. Where fewer than "
+          f"{SETTLED:.0%} of 2000 bootstrap resamples of the seeds (other sets of {n_seeds}) give the same verdict, "
+          "the verdict is marked *unsettled*: another set of seeds may well give another.", "",
           "| case | quantity | engine | observed | simulated | verdict |", "|---|---|---|---|---|---|"]
     for r in rows:
         v = r["verdict"] if passes(r["verdict"]) else f"**outside**: {r['how']}"
+        if r["settled"] < SETTLED:
+            v += f" (*unsettled*: {r['settled']:.0%} of resamples agree)"
         md.append(f"| {r['case']} | {r['quantity']} | {r['engine']} | {r['observed']} | {r['simulated']} | {v} |")
     md.append("")
     misses = [r for r in rows if not passes(r["verdict"])]
@@ -445,7 +535,8 @@ def write(ctx):
 
     # Case 1 text, sensitivity and figure.
     md += ["### 1. Wind drift, and the pack against a coast", "",
-           f"`{rel(ctx.run('obs_drift'))}`: the average Barents Sea iceberg (140 m x 70 m, 50 m draft, 11 m sail, "
+           f"`{rel(ctx.run('obs_drift'))}` (the scene's own seed; the table above: all {n_seeds}): the average "
+           "Barents Sea iceberg (140 m x 70 m, 50 m draft, 11 m sail, "
            f"927 000 t) among {drift['n_floes']} floes of 50 to 500 m, 1 m thick, at 70 %, 78 deg N, a steady "
            f"10 m/s wind, no current (Zubakin and Ivanov: 10 icebergs and 18 ice fields tracked by GPS in the "
            f"north-eastern Barents Sea, May to September 2009). Means over t = {drift['window'][0]:.0f} to "
@@ -455,7 +546,7 @@ def write(ctx):
            f"at {bf:.4f}, {bd:+.1f} deg. Deflection is counted to the right of the wind, as drift turns in the "
            "northern hemisphere.", "",
            "Sensitivity to the water form drag coefficient C_w (both kinds; the wind factor goes as "
-           "sqrt(C_a / C_w) where form drag dominates):", "",
+           "sqrt(C_a / C_w) where form drag dominates), on the scene's own seed:", "",
            "| C_w | floes: factor | floes: deflection | iceberg: factor | iceberg: deflection | file |",
            "|---|---|---|---|---|---|"]
     for cw in sorted(sens):

@@ -33,6 +33,28 @@ def test_ranges_inside_overlapping_and_apart():
     assert obs.passes("inside") and obs.passes("overlaps") and not obs.passes("outside")
 
 
+def test_ensemble_verdicts_are_on_the_interval_of_the_mean():
+    # Eight seeds well inside: the interval (mean +- t s / sqrt(n)) is inside, and every resample agrees.
+    v, how, settled = obs.ensemble_verdict([0.019, 0.0195, 0.0188, 0.0192, 0.0191, 0.0189, 0.0193, 0.019],
+                                           (0.016, 0.023))
+    assert (v, how, settled) == ("inside", "", 1.0)
+    # A mean inside whose interval reaches past the end: overlaps, not inside.
+    m, half, sd = obs.interval([0.0155, 0.0175, 0.016, 0.017])
+    assert m - half < 0.016 < m + half
+    assert obs.ensemble_verdict([0.0155, 0.0175, 0.016, 0.017], (0.016, 0.023))[0] == "overlaps"
+    # Apart: the factor from the interval's nearest end, not from the mean.
+    values = [0.0171, 0.0175, 0.0168, 0.019, 0.0172, 0.018, 0.0169, 0.0177]
+    m, half, _ = obs.interval(values)
+    v, how, settled = obs.ensemble_verdict(values, (0.010, 0.015))
+    assert v == "outside" and how == f"{(m - half) / 0.015:.2g}x the upper end" and settled == 1.0
+    # An interval that straddles the end: another set of seeds may well fall either side.
+    v, _, settled = obs.ensemble_verdict([15.1, 14.2, 16.0, 17.5, 15.0, 14.8, 15.3, 16.1], (10.0, 15.0), angle=True)
+    assert v == "overlaps" and settled < obs.SETTLED
+    # The resamples are a fixed stream: the same seeds, the same share.
+    assert obs.ensemble_verdict([15.1, 14.2, 16.0, 17.5], (10.0, 15.0), True) == \
+        obs.ensemble_verdict([15.1, 14.2, 16.0, 17.5], (10.0, 15.0), True)
+
+
 def rows(**verdicts):
     return [dict(id=k, case="c", quantity="q", engine="native", observed="o", simulated="s", verdict=v, how="h")
             for k, v in verdicts.items()]
