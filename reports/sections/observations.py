@@ -73,11 +73,9 @@ OBS_TEXT = {
 # The likely cause of a miss, by row id: the model's assumption that the observation questions.
 CAUSES = {
     "drift_berg_factor": "the iceberg's wind factor is set by its sail's air drag against its keel's water drag, "
-                         "sqrt(rho_a C_a A_sail / (rho_w C_w A_keel)), 0.020 in open water for this iceberg. floedem's "
-                         "keel is the waterline polygon carried down to the draft: the published mass (927 000 t, "
-                         "2.3 times the prism's) says the real keel is wider, and a wider keel drifts slower (the "
-                         "sensitivity "
-                         "table's C_w = 1.5 stands for a keel of 1.7 times the area).",
+                         "sqrt(rho_a C_a A_sail / (rho_w C_w A_keel)). The keel is the mean section the published "
+                         "mass implies (1.57 times the waterline's width); how keel and sail change with height is "
+                         "not published, and the factor goes as the square root of their ratio.",
     "drift_berg_deflection": "the deflection comes from Coriolis on the iceberg's mass (with added mass) against a "
                              "water drag along the relative velocity; the observed turning also carries the ocean "
                              "boundary layer's own turning, which the model does not have. Within a degree of the "
