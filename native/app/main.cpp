@@ -120,8 +120,6 @@ struct ReportCommand {
   }
 };
 
-// `floedem check`: the scenario loaded, overrides applied and each engine built, as a run would,
-// and nothing run (a sweep checks every point with it before it starts).
 /// `floedem check`'s lines for a field from an ice chart: each polygon's codes, what they gave
 /// the generator and what it made (the /field provenance the output will hold).
 void print_chart(const floedem::Scene& scene) {
@@ -152,6 +150,8 @@ void print_chart(const floedem::Scene& scene) {
   }
 }
 
+// `floedem check`: the scenario loaded, overrides applied and each engine built, as a run would,
+// and nothing run (a sweep checks every point with it before it starts).
 struct CheckCommand {
   std::string scenario;
   std::vector<std::string> overrides, engines;

@@ -57,16 +57,22 @@ bool read_code(OGRFeature& f, int index, int& out, std::string& text) {
   return used == text.size();
 }
 
-/// A ring's vertices without the repeated closing vertex and without repeats.
-std::vector<Vec2> ring_points(const OGRLinearRing& ring) {
+/// A ring's points without repeated neighbours and without the closing repeat of the first.
+std::vector<Vec2> without_repeats(const std::vector<Vec2>& pts) {
   std::vector<Vec2> out;
-  out.reserve(static_cast<std::size_t>(ring.getNumPoints()));
-  for (int i = 0; i < ring.getNumPoints(); ++i) {
-    const Vec2 p{ring.getX(i), ring.getY(i)};
+  out.reserve(pts.size());
+  for (const Vec2 p : pts)
     if (out.empty() || p != out.back()) out.push_back(p);
-  }
   while (out.size() > 1 && out.front() == out.back()) out.pop_back();
   return out;
+}
+
+/// An OGR ring's vertices, without repeats (without_repeats).
+std::vector<Vec2> ring_points(const OGRLinearRing& ring) {
+  std::vector<Vec2> pts;
+  pts.reserve(static_cast<std::size_t>(ring.getNumPoints()));
+  for (int i = 0; i < ring.getNumPoints(); ++i) pts.push_back({ring.getX(i), ring.getY(i)});
+  return without_repeats(pts);
 }
 
 std::unique_ptr<OGRLinearRing> make_ring(const std::vector<Vec2>& pts) {
@@ -116,11 +122,7 @@ double area_of(const OGRGeometry* g) {
 ChartPart part_of(const OGRPolygon& p) {
   ChartPart part;
   std::vector<Vec2> ring = ring_points(*p.getExteriorRing());
-  Vec2 lo = ring[0], hi = ring[0];
-  for (const Vec2 v : ring) {
-    lo = {std::min(lo.x, v.x), std::min(lo.y, v.y)};
-    hi = {std::max(hi.x, v.x), std::max(hi.y, v.y)};
-  }
+  const auto [lo, hi] = bounds_of(ring);
   const double tol = 1e-9 * std::max(hi.x - lo.x, hi.y - lo.y);
   for (Vec2& v : ring) {
     if (v.x - lo.x <= tol) v.x = lo.x;
@@ -128,9 +130,7 @@ ChartPart part_of(const OGRPolygon& p) {
     if (v.y - lo.y <= tol) v.y = lo.y;
     if (hi.y - v.y <= tol) v.y = hi.y;
   }
-  for (const Vec2 v : ring)
-    if (part.outer.empty() || v != part.outer.back()) part.outer.push_back(v);
-  while (part.outer.size() > 1 && part.outer.front() == part.outer.back()) part.outer.pop_back();
+  part.outer = without_repeats(ring);  // the snap can make neighbours equal
   if (signed_area(part.outer) < 0.0) std::reverse(part.outer.begin(), part.outer.end());
   for (int k = 0; k < p.getNumInteriorRings(); ++k) part.holes.push_back(ring_points(*p.getInteriorRing(k)));
   return part;
@@ -296,11 +296,7 @@ double perimeter_position(Vec2 p, Vec2 lo, Vec2 hi) {
 /// same order along both) enclose one pocket, which is simple because the chain meets the
 /// outline only at its ends. Together the pockets are the box less the polygon.
 std::vector<std::vector<Vec2>> box_pockets(const std::vector<Vec2>& ring) {
-  Vec2 lo = ring[0], hi = ring[0];
-  for (const Vec2 p : ring) {
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
-  }
+  const auto [lo, hi] = bounds_of(ring);
   const std::size_t n = ring.size();
   std::vector<std::size_t> touch;
   for (std::size_t i = 0; i < n; ++i)
@@ -353,7 +349,6 @@ Field generate_chart_field(const IceChart& chart, const FieldSpec& base, std::ve
   }
   Field field;
   stats.clear();
-  std::vector<double> diameters;
   for (std::size_t i = 0; i < chart.polygons.size(); ++i) {
     const ChartPolygon& poly = chart.polygons[i];
     ChartPolygonStats st;
@@ -380,25 +375,24 @@ Field generate_chart_field(const IceChart& chart, const FieldSpec& base, std::ve
     }
     std::vector<const OGRPolygon*> pieces;
     for (const GeometryPtr& g : region) collect_polygons(g.get(), pieces);
-    for (const OGRPolygon* p : pieces) st.free_area += area_of(p);
+    std::vector<double> piece_area;
+    for (const OGRPolygon* p : pieces) {
+      piece_area.push_back(p->get_Area());
+      st.free_area += piece_area.back();
+    }
     if (poly.concentration > 0.0) {
       const double c = std::min(poly.concentration, FieldSpec::max_concentration);
       std::vector<double> d_poly;
       for (std::size_t k = 0; k < pieces.size(); ++k) {
-        const double area = area_of(pieces[k]);
         // The generator needs the free area to hold the cell of its largest floe, pi d_max^2 / (4 C).
-        const double d_fit = std::sqrt(4.0 * c * area / std::numbers::pi);
+        const double d_fit = std::sqrt(4.0 * c * piece_area[k] / std::numbers::pi);
         if (!(d_fit >= poly.d_min)) {
           ++st.pieces_too_small;
           continue;
         }
         const ChartPart part = part_of(*pieces[k]);
         FieldSpec spec;
-        Vec2 plo = part.outer[0], phi = part.outer[0];
-        for (const Vec2 v : part.outer) {
-          plo = {std::min(plo.x, v.x), std::min(plo.y, v.y)};
-          phi = {std::max(phi.x, v.x), std::max(phi.y, v.y)};
-        }
+        const auto [plo, phi] = bounds_of(part.outer);
         spec.origin = plo;
         spec.width = phi.x - plo.x;
         spec.height = phi.y - plo.y;

@@ -38,7 +38,7 @@ constexpr Entry kCompact{92, {1.0, 1.0, "10/10"}};
 // first-year: over 120 cm) the upper is first-year ice's 2 m; old, second- and multi-year ice
 // run from first-year's 2 m to their typical thickness (2.5 m second-year, 3 m old and
 // multi-year).
-constexpr std::array<Entry, 15> kStage{{
+constexpr std::array<Entry, 14> kStage{{
     {81, {0.05, 0.10, "new ice"}},
     {82, {0.05, 0.10, "nilas, ice rind"}},
     {83, {0.10, 0.30, "young ice"}},
@@ -53,12 +53,11 @@ constexpr std::array<Entry, 15> kStage{{
     {95, {2.00, 3.00, "old ice"}},
     {96, {2.00, 2.50, "second-year ice"}},
     {97, {2.00, 3.00, "multi-year ice"}},
-    {0, {0.0, 0.0, ""}},  // sentinel, never matched (ice-free polygons are not asked)
 }};
 
 // FA: the nomenclature's horizontal extents. Small ice cakes and brash are "under 2 m": the
 // lower end is taken as 0.5 m.
-constexpr std::array<Entry, 8> kForm{{
+constexpr std::array<Entry, 7> kForm{{
     {22, {0.3, 3.0, "pancake ice"}},
     {1, {0.5, 2.0, "small ice cake, brash ice"}},
     {2, {2.0, 20.0, "ice cake"}},
@@ -66,13 +65,12 @@ constexpr std::array<Entry, 8> kForm{{
     {4, {100.0, 500.0, "medium floe"}},
     {5, {500.0, 2000.0, "big floe"}},
     {6, {2000.0, 10000.0, "vast floe"}},
-    {0, {0.0, 0.0, ""}},  // sentinel
 }};
 
 template <std::size_t N>
 std::optional<CodeRange> find(const std::array<Entry, N>& table, int code) {
   for (const Entry& e : table)
-    if (e.code == code && e.range.name[0] != '\0') return e.range;
+    if (e.code == code) return e.range;
   return std::nullopt;
 }
 
@@ -80,7 +78,6 @@ template <std::size_t N>
 std::string list(const std::array<Entry, N>& table) {
   std::string out;
   for (const Entry& e : table) {
-    if (e.range.name[0] == '\0') continue;
     char buf[16];
     std::snprintf(buf, sizeof buf, "%s%02d", out.empty() ? "" : ", ", e.code);
     out += buf;
