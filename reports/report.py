@@ -7,7 +7,7 @@ written all the same), 4 when a run failed (no report written).
 
 `floedem report [--quick] [--out DIR]` runs this (the main job runs the quick one).
 
-usage: report.py [--floedem build/floedem] [--out results/report] [--quick] [--jobs N] [--only S,...]
+usage: report.py [--floedem build/floedem] [--out results/report] [--quick] [--jobs N] [--only S,...] [--resume]
 """
 import argparse
 import datetime
@@ -79,6 +79,9 @@ def main():
                     help="the same sections on smaller and shorter cases (the CI cross-check, a few minutes)")
     ap.add_argument("--jobs", type=int, default=len(os.sched_getaffinity(0)),
                     help="runs at a time (default: the CPUs this process may use)")
+    ap.add_argument("--resume", action="store_true",
+                    help="keep the runs an interrupted report into the same --out finished, where the program, "
+                         "the command and the scenario's folder are the same as now; make the rest")
     names = [s.__name__.split(".")[-1] for s in SECTIONS]
     ap.add_argument("--only", default="",
                     help=f"a partial report of these sections alone, comma-separated ({', '.join(names)})")
@@ -101,9 +104,12 @@ def main():
         print(f"report: this build has no {', '.join(missing)} engine: their runs and checks are skipped", flush=True)
     ctx = Context(a, engines)
     load_stage_labels(a.floedem)
+    # Nothing in the report may come from an earlier run, except, with --resume, runs of the same
+    # program, command and inputs (report_runner.run_all checks each): the runs are deterministic.
+    for d in (ctx.fig,) if a.resume else (ctx.fig, ctx.runs_dir):
+        shutil.rmtree(d, ignore_errors=True)
     for d in (ctx.fig, ctx.runs_dir):
-        shutil.rmtree(d, ignore_errors=True)   # nothing in the report may come from an earlier run
-        os.makedirs(d)
+        os.makedirs(d, exist_ok=True)
     report = os.path.join(ctx.out, "REPORT.md")
     if os.path.exists(report):
         os.remove(report)
@@ -120,7 +126,7 @@ def main():
     print(f"report: {len(ctx.all_runs)} runs on {', '.join(engines)}, {a.jobs} at a time, into {ctx.runs_dir}",
           flush=True)
     launch_start = time.monotonic()
-    failed = run_all(ctx.all_runs, a.floedem, ctx.runs_dir, a.jobs, "report")
+    failed = run_all(ctx.all_runs, a.floedem, ctx.runs_dir, a.jobs, "report", resume=a.resume)
     ctx.launch_seconds = time.monotonic() - launch_start
     # The stress suite's runs may fail (a non-finite state is one of its outcomes): not an error.
     failed = [r for r in failed if not r.meta.get("may_fail")]

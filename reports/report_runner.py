@@ -1,6 +1,7 @@
 """Runs of `floedem run` for the report: what to run (Run), and running a list of them through
 floedem.launch (Snakemake), with a progress line per finished run. A run that fails stops
 nothing else; its error is kept and the caller decides (the report fails at the end, naming it)."""
+import hashlib
 import os
 import sys
 from dataclasses import dataclass, field
@@ -24,6 +25,7 @@ class Run:
                                 # made after the others, alone (nothing else shares the cores)
     threads: int = 0            # FLOEDEM_THREADS; 0: 1 for a timing run, else the cores / jobs
     bench_stages: bool = False  # a timing run that also times each stage (`floedem bench --stages`)
+    stamp: str = ""             # filled in by run_all: the digest of the program and inputs
 
     @property
     def timed(self):
@@ -40,26 +42,89 @@ class Run:
         return cmd
 
 
-def run_all(runs, floedem, runs_dir, jobs, label="report"):
+def _digest_file(path, h):
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+
+
+class Stamps:
+    """A run's stamp: a digest of the program (the floedem binary's bytes) and of the files beside
+    its scenario (the scenario and whatever it reads from its folder: forcing files, charts).
+    Equal stamps and equal commands give equal results (floedem's runs are deterministic), so a
+    resumed report may keep a run made earlier under the same stamp."""
+
+    def __init__(self, floedem):
+        h = hashlib.sha256()
+        _digest_file(os.path.realpath(floedem), h)
+        self.program = h.hexdigest()
+        self.folders = {}
+
+    def folder(self, d):
+        if d not in self.folders:
+            h = hashlib.sha256()
+            for name in sorted(os.listdir(d)):
+                p = os.path.join(d, name)
+                if os.path.isfile(p):
+                    h.update(name.encode() + b"\0")
+                    _digest_file(p, h)
+            self.folders[d] = h.hexdigest()
+        return self.folders[d]
+
+    def of(self, run):
+        return hashlib.sha256((self.program + self.folder(os.path.dirname(os.path.abspath(run.scenario))))
+                              .encode()).hexdigest()
+
+
+def _finished(runs_dir, r, floedem):
+    """Whether r's output in runs_dir is a finished run of r's command under r's stamp."""
+    import json
+    p = os.path.join(runs_dir, ".floedem", "done", r.tag + ".json")
+    if not os.path.exists(p) or not os.path.exists(r.out) or os.path.exists(r.out + ".partial"):
+        return False
+    try:
+        with open(p) as f:
+            rec = json.load(f)
+    except (OSError, ValueError):
+        return False
+    # A failed run is made again, unless failing is one of its outcomes (the stress suite's).
+    ok = rec.get("returncode") == 0 or r.meta.get("may_fail")
+    return ok and rec.get("argv") == r.command(floedem) and rec.get("stamp") == r.stamp
+
+
+def run_all(runs, floedem, runs_dir, jobs, label="report", resume=False):
     """Runs every Run into runs_dir through floedem.launch (Snakemake, the project's one way of
     launching runs): `jobs` at a time, the longest first, then the timing runs one at a time,
-    alone. Prints one line per finished run. Returns the runs that failed."""
+    alone. Prints one line per finished run. Returns the runs that failed.
+
+    resume: keep a run already in runs_dir whose record says it finished with the same command
+    and the same stamp (Stamps); every other output is removed and made again."""
     os.makedirs(runs_dir, exist_ok=True)
+    stamps = Stamps(floedem)
+    kept = 0
     for r in runs:
         r.out = os.path.join(runs_dir, r.tag + (".csv" if r.timed else ".h5"))
-        for stale in (r.out, r.out + ".partial"):
+        r.stamp = stamps.of(r)
+        if resume and _finished(runs_dir, r, floedem):
+            kept += 1
+            continue
+        for stale in (r.out, r.out + ".partial", os.path.join(runs_dir, ".floedem", "done", r.tag + ".json"),
+                      os.path.join(runs_dir, ".floedem", "done", r.tag + ".failed.json")):
             if os.path.exists(stale):
                 os.remove(stale)
+    if resume:
+        print(f"{label}: resuming: {kept} of {len(runs)} runs kept from before (same program, command and inputs)",
+              flush=True)
     cores = len(os.sched_getaffinity(0))
     # Threads per run: runs made side by side share the cores; a timing is single-threaded
     # unless it says otherwise (the thread-scaling runs), and shares the machine with nothing.
     share = max(1, cores // max(1, jobs))
     untimed = sorted([r for r in runs if not r.timed], key=lambda r: -r.cost)
     todo = [Job(r.tag, r.command(floedem), threads=r.threads or share, priority=len(untimed) - k + 1000,
-                may_fail=True) for k, r in enumerate(untimed)]
+                may_fail=True, stamp=r.stamp) for k, r in enumerate(untimed)]
     ids = [j.id for j in todo]
-    todo += [Job(r.tag, r.command(floedem), threads=r.threads or 1, alone=True, after=ids, may_fail=True)
-             for r in runs if r.timed]
+    todo += [Job(r.tag, r.command(floedem), threads=r.threads or 1, alone=True, after=ids, may_fail=True,
+                 stamp=r.stamp) for r in runs if r.timed]
     records, _ = launch(todo, runs_dir, cores=min(cores, max(1, jobs) * share), label=label)
     failed = []
     for r in runs:

@@ -94,7 +94,7 @@ struct RunCommand {
 // `floedem report`: the cross-engine report (reports/report.py).
 struct ReportCommand {
   std::string out = "results/report", only;
-  bool quick = false;
+  bool quick = false, resume = false;
   int jobs = 0;
   CLI::App* app = nullptr;
 
@@ -108,11 +108,15 @@ struct ReportCommand {
                     "a partial report of these sections alone, comma-separated (report.py names them; an unknown one "
                     "is refused with the list)");
     app->add_option("--jobs,-j", jobs, "runs at a time (default: the number of cores)")->check(CLI::PositiveNumber);
+    app->add_flag("--resume", resume,
+                  "keep the runs an interrupted report into the same --out finished with the same program, command "
+                  "and scenario inputs; make the rest");
   }
   int run() const {
     // Exit status as the script's: 0 agreement, 5 disagreement, 4 a run failed.
     std::vector<std::string> args{"--floedem", floedem::own_executable(), "--out", out};
     if (quick) args.emplace_back("--quick");
+    if (resume) args.emplace_back("--resume");
     if (jobs > 0) args.insert(args.end(), {"--jobs", std::to_string(jobs)});
     if (!only.empty()) args.insert(args.end(), {"--only", only});
     const int status = floedem::run_python_script("report.py", args);

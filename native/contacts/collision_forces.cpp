@@ -1,7 +1,11 @@
 #include "contacts/collision_forces.hpp"
 
+#include "floedem/scene/input_error.hpp"
+
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace floedem {
@@ -9,6 +13,158 @@ namespace floedem {
 double collision_duration(double duration_coefficient, double m_eff) { return duration_coefficient * std::sqrt(m_eff); }
 double collision_mean_force(double impulse, double duration) { return impulse / duration; }
 double collision_peak_force(double impulse, double duration) { return std::numbers::pi * impulse / (2.0 * duration); }
+
+CrushingLaw CrushingLaw::of(const ContactSettings& contact) {
+  CrushingLaw law;
+  law.stiffness = std::pow(std::numbers::pi / contact.duration_coefficient, 2);
+  law.coefficient = contact.crushing_coefficient;
+  law.width_exponent = contact.crushing_width_exponent;
+  law.thickness_exponent = contact.crushing_thickness_exponent;
+  law.iso_thickness_exponent = !contact.has_crushing_thickness_exponent;
+  return law;
+}
+
+double CrushingLaw::exponent_n(double h) const {
+  // ISO 19906 A.8.2.4.3.3: n = -0.5 + h / 5 for h < 1 m, -0.3 from 1 m up.
+  return iso_thickness_exponent ? std::min(-0.3, 0.2 * h - 0.5) : thickness_exponent;
+}
+
+namespace {
+
+/// Gauss-Legendre nodes and weights on [0, 1] (Newton on P_N from Chebyshev guesses).
+struct GaussLegendre {
+  static constexpr int N = 24;
+  std::array<double, N> x{}, w{};
+  GaussLegendre() {
+    for (int i = 0; i < N; ++i) {
+      double z = std::cos(std::numbers::pi * (i + 0.75) / (N + 0.5)), dp = 0.0;
+      for (int it = 0; it < 100; ++it) {
+        double p0 = 1.0, p1 = z;
+        for (int k = 2; k <= N; ++k) {
+          const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
+          p0 = p1;
+          p1 = p2;
+        }
+        dp = N * (z * p1 - p0) / (z * z - 1.0);
+        const double dz = p1 / dp;
+        z -= dz;
+        if (std::abs(dz) < 1e-16) break;
+      }
+      x[static_cast<std::size_t>(i)] = 0.5 * (1.0 - z);
+      w[static_cast<std::size_t>(i)] = 1.0 / ((1.0 - z * z) * dp * dp);
+    }
+  }
+};
+
+}  // namespace
+
+CrushingPulse crushing_pulse(double J, double m, const CrushingLaw& law, const ContactWidth& cw) {
+  // Loading: m from u = J / (2 m) to rest against F(delta), the energy E = m u^2 / 2 into
+  // W(delta) = integral of F. Spring branch F = k delta up to delta_s = sqrt(2 E / k).
+  CrushingPulse out;
+  const double k = law.stiffness, u = J / (2.0 * m), E = 0.5 * m * u * u;
+  const double h = cw.thickness, g = cw.growth, w0 = cw.initial;
+  const double q = 1.0 + law.width_exponent;  // F_c = K w^q
+  const double K = law.coefficient * std::pow(h, 1.0 + law.exponent_n(h) - law.width_exponent);
+  const auto cap = [&](double d) { return K * std::pow(w0 + g * d, q); };
+  const double delta_s = std::sqrt(2.0 * E / k);
+  const double spring_time = 0.5 * std::numbers::pi * std::sqrt(m / k);
+  if (!(J > 0.0) || !(m > 0.0) || !(h > 0.0) || k * delta_s <= cap(delta_s)) {
+    // k delta - F_c is convex and <= 0 at 0: below the cap at delta_s, below it all the way.
+    out.duration = 2.0 * spring_time;
+    out.peak_force = k * delta_s;
+    out.width = w0 + g * delta_s;
+    out.overlap = delta_s;
+    return out;
+  }
+  // The crossover delta* in [0, delta_s): k delta = F_c (one root: the difference is convex).
+  double lo = 0.0, hi = delta_s;
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * delta_s; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (k * mid <= cap(mid) ? lo : hi) = mid;
+  }
+  const double ds = 0.5 * (lo + hi), Ws = 0.5 * k * ds * ds, ws = w0 + g * ds;
+  // Crushing branch: W(delta) - W* = K (w^(q+1) - w*^(q+1)) / (g (q+1)), or K w0^q (delta - delta*)
+  // for a width that does not grow; W(delta_m) = E gives delta_m in closed form.
+  double dm;
+  if (g > 0.0) {
+    const double wm = std::pow(std::pow(ws, q + 1.0) + (E - Ws) * g * (q + 1.0) / K, 1.0 / (q + 1.0));
+    dm = (wm - w0) / g;
+  } else {
+    dm = ds + (E - Ws) / (K * std::pow(w0, q));
+  }
+  out.crushed = true;
+  out.overlap = dm;
+  out.width = w0 + g * dm;
+  out.peak_force = cap(dm);
+  // Loading time: the spring branch in closed form, sqrt(m / k) asin(delta* sqrt(k / m) / u);
+  // the crushing branch integral of d delta / v, v = sqrt(2 (E - W(delta)) / m), with
+  // delta = delta_m - (delta_m - delta*) s^2 to take out the 1 / sqrt singularity at rest.
+  // E - W(delta) = W(delta_m) - W(delta) in a form that does not cancel as delta -> delta_m.
+  const auto energy_left = [&](double d) {
+    if (g > 0.0) {
+      const double w = w0 + g * d, r = std::log1p(g * (dm - d) / w);
+      return K * std::pow(w, q + 1.0) * std::expm1((q + 1.0) * r) / (g * (q + 1.0));
+    }
+    return K * std::pow(w0, q) * (dm - d);
+  };
+  static const GaussLegendre gl;
+  double crush_time = 0.0;
+  for (int i = 0; i < GaussLegendre::N; ++i) {
+    const double sv = gl.x[static_cast<std::size_t>(i)], d = dm - (dm - ds) * sv * sv;
+    crush_time += gl.w[static_cast<std::size_t>(i)] * 2.0 * (dm - ds) * sv / std::sqrt(2.0 * energy_left(d) / m);
+  }
+  const double spring_part = std::sqrt(m / k) * std::asin(std::min(1.0, ds * std::sqrt(k / m) / u));
+  out.duration = 2.0 * (spring_part + crush_time);
+  return out;
+}
+
+double contact_thickness(const BodySpec& body) {
+  return body.kind == BodyKind::iceberg ? body.draft + body.freeboard : body.thickness;
+}
+
+namespace {
+
+/// The corner of `body` (pose x, angle) nearest `point`: its distance and 2 tan(alpha / 2),
+/// alpha its interior angle (a reflex corner, alpha >= 180 deg, is no corner: growth infinite).
+std::pair<double, double> nearest_corner(const BodySpec& body, Vec2 x, double angle, Vec2 point) {
+  const Vec2 p = Rot::from_angle(angle).apply_inverse(point - x);
+  const std::vector<Vec2>& poly = body.local_polygon;
+  const std::size_t n = poly.size();
+  double best = std::numeric_limits<double>::infinity(), growth = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = length(poly[i] - p);
+    if (!(d < best)) continue;
+    best = d;
+    // Counter-clockwise polygon: the interior angle between the edges to the neighbours.
+    const Vec2 to_prev = normalized(poly[(i + n - 1) % n] - poly[i]), to_next = normalized(poly[(i + 1) % n] - poly[i]);
+    const double turn = cross(to_next, to_prev), alpha = std::atan2(turn, dot(to_next, to_prev));
+    growth = alpha > 0.0 && alpha < std::numbers::pi * (1.0 - 1e-9) ? 2.0 * std::tan(0.5 * alpha)
+                                                                      : std::numeric_limits<double>::infinity();
+  }
+  return {best, growth};
+}
+
+}  // namespace
+
+ContactWidth contact_width_law(const BodySpec& a, Vec2 xa, double angle_a, const BodySpec& b, Vec2 xb, double angle_b,
+                               Vec2 point, double spread) {
+  ContactWidth cw;
+  cw.thickness = std::min(contact_thickness(a), contact_thickness(b));
+  cw.initial = spread;
+  const double size = std::sqrt(std::min(a.area, b.area)), tolerance = 0.01 * size;
+  if (spread > tolerance) return cw;  // a face on a face: the width is the points' spread
+  const auto [da, ga] = nearest_corner(a, xa, angle_a, point);
+  const auto [db, gb] = nearest_corner(b, xb, angle_b, point);
+  double g = std::numeric_limits<double>::infinity();
+  if (da <= tolerance) g = std::min(g, ga);
+  if (db <= tolerance) g = std::min(g, gb);
+  // No corner at the point (two faces touching at one point, as a compliant engine's single
+  // point may be): the width is what the points give, and does not grow.
+  cw.growth = std::isfinite(g) ? g : 0.0;
+  if (cw.growth == 0.0 && cw.initial <= 0.0) cw.initial = tolerance;
+  return cw;
+}
 
 double effective_mass(Vec2 n, Vec2 r_a, double inv_mass_a, double inv_inertia_a, Vec2 r_b, double inv_mass_b,
                       double inv_inertia_b) {
@@ -61,7 +217,16 @@ CollisionTracker::CollisionTracker(const Scene& scene, DurationModel model)
       c_tau_(scene.contact.duration_coefficient),
       dt_(scene.run.dt),
       threshold_(scene.contact.collision_threshold),
-      model_(model) {}
+      model_(model),
+      crushing_(scene.contact.force_model == ContactSettings::ForceModel::pressure_area),
+      crushing_law_(CrushingLaw::of(scene.contact)) {
+  // A compliant engine measures its pulses on its own spring: a crushing cap would have to be
+  // in that spring, which no reference engine has.
+  if (crushing_ && model_ == DurationModel::measured)
+    throw InputError(input_message(scene.source_path, 0, "contact.force_model",
+                                   "\"pressure_area\" estimates pulses from impulses; an engine with "
+                                   "contact_model = \"compliant\" measures its own: use \"linear\" there"));
+}
 
 CollisionTracker::Event CollisionTracker::open_event(double t_end, const StepPair& p, const BodyStates& after) const {
   Event e;
@@ -89,6 +254,11 @@ CollisionTracker::Event CollisionTracker::open_event(double t_end, const StepPai
   const Vec2 va = after.velocity[a] + cross(after.angular_velocity[a], ra);
   const Vec2 vb = after.velocity[b] + cross(after.angular_velocity[b], rb);
   row.restitution_achieved = approach > 0.0 ? dot(vb - va, normal) / approach : 0.0;
+  if (crushing_) {
+    const double ta = after.angle[a] - dt_ * after.angular_velocity[a];
+    const double tb = after.angle[b] - dt_ * after.angular_velocity[b];
+    e.width = contact_width_law(scene_.bodies[a], xa, ta, scene_.bodies[b], xb, tb, point, p.spread_max - p.spread_min);
+  }
   if (model_ == DurationModel::measured) {
     e.normal = normal;
     e.local_a = Rot::from_angle(after.angle[a]).apply_inverse(point - after.position[a]);
@@ -111,6 +281,16 @@ void CollisionTracker::sum_by_pair(std::span<const ContactRecord> contacts) {
     }
     StepPair& p = step_pairs_.back();
     if (c.normal_impulse > 0.0) p.impulse += c.normal_impulse;
+    if (crushing_) {
+      // The touching points' extent across the pair's (first) normal: the contact's width.
+      if (p.tangent == Vec2{}) {
+        p.tangent = perp(c.normal);
+        p.spread_min = p.spread_max = dot(c.point, p.tangent);
+      }
+      const double s = dot(c.point, p.tangent);
+      p.spread_min = std::min(p.spread_min, s);
+      p.spread_max = std::max(p.spread_max, s);
+    }
     // What starts an event: an impulse at a point approaching faster than the threshold
     // (the engines' collision kind; a compliant engine's records say the same).
     const bool impact = model_ == DurationModel::estimated ? c.kind == ContactKind::collision
@@ -197,6 +377,14 @@ CollisionRow CollisionTracker::complete(const Event& e, const BodyStates& now) c
     row.duration = collision_duration(c_tau_, row.effective_mass);
     row.mean_force = collision_mean_force(row.normal_impulse, row.duration);
     row.peak_force = collision_peak_force(row.normal_impulse, row.duration);
+    if (crushing_) {
+      const CrushingPulse pulse = crushing_pulse(row.normal_impulse, row.effective_mass, crushing_law_, e.width);
+      row.duration = pulse.duration;
+      row.mean_force = collision_mean_force(row.normal_impulse, pulse.duration);
+      row.peak_force = pulse.peak_force;
+      row.contact_width = pulse.width;
+      row.crushed = pulse.crushed ? 1 : 0;
+    }
     return row;
   }
   row.duration = static_cast<double>(e.last_step - e.first_step + 1) * dt_;
@@ -236,6 +424,8 @@ void CollisionTracker::save(StateWriter& out) const {
     out.value(e.first_step);
     out.value(e.last_step);
     for (const Vec2 v : {e.normal, e.local_a, e.local_b}) out.value(v);
+    if (crushing_)  // only then: the linear model's checkpoints keep their bytes
+      for (const double v : {e.width.thickness, e.width.initial, e.width.growth}) out.value(v);
   }
 }
 
@@ -261,6 +451,8 @@ void CollisionTracker::restore(StateReader& in) {
     in.value(e.first_step);
     in.value(e.last_step);
     for (Vec2* v : {&e.normal, &e.local_a, &e.local_b}) in.value(*v);
+    if (crushing_)
+      for (double* v : {&e.width.thickness, &e.width.initial, &e.width.growth}) in.value(*v);
     if (!open_.empty() && !(open_.back().key < key)) throw StateError("checkpoint: collision events out of pair order");
     open_.push_back({key, store(e)});
   }

@@ -37,12 +37,54 @@ struct CollisionRow {
   double duration = 0.0;              ///< s, tau = C_tau sqrt(m_eff)
   double mean_force = 0.0;            ///< N, J / tau
   double peak_force = 0.0;            ///< N, pi J / (2 tau)
+  double contact_width = 0.0;         ///< m, pressure_area: the nominal contact width at the peak
+  std::uint8_t crushed = 0;           ///< pressure_area: 1 where the crushing pressure capped the force
 };
 
 /// docs/model.md 4: the half-sine pulse of a linear spring.
 double collision_duration(double duration_coefficient, double effective_mass);
 double collision_mean_force(double impulse, double duration);
 double collision_peak_force(double impulse, double duration);
+
+/// The pressure-area model (docs/model.md 4): the contact force of the linear model's spring,
+/// k delta, capped by the crushing force of the nominal contact area,
+///   F(delta) = min(k delta, p(w, h) w h),   p = C_R (h / 1 m)^n (w / h)^m   (ISO 19906 A.8.2.4.3.3),
+///   w(delta) = w0 + g delta
+/// (delta: the overlap along the normal; h: the thinner body's thickness; w0: the spread of the
+/// impact step's contact points; g = 2 tan(alpha / 2) where a corner of interior angle alpha
+/// meets the other body, 0 for a face on a face). The pulse is the linear model's: symmetric,
+/// half the impulse J loading (m_eff from J / (2 m_eff) to rest against F) and half unloading
+/// its mirror image, so that where the cap is never reached it is the linear model's half-sine.
+struct CrushingLaw {
+  double stiffness = 0.0;            ///< k = (pi / C_tau)^2, N/m
+  double coefficient = 0.0;          ///< C_R, Pa
+  double width_exponent = 0.0;       ///< m
+  double thickness_exponent = 0.0;   ///< n
+  bool iso_thickness_exponent = true;///< n = min(-0.3, 0.2 h - 0.5) (h in m) instead
+  static CrushingLaw of(const ContactSettings& contact);
+  double exponent_n(double thickness) const;
+};
+struct ContactWidth {
+  double thickness = 0.0;  ///< h, m
+  double initial = 0.0;    ///< w0, m
+  double growth = 0.0;     ///< g, m of width per m of overlap
+};
+struct CrushingPulse {
+  double duration = 0.0;     ///< s, twice the loading time
+  double peak_force = 0.0;   ///< N, F at the deepest overlap
+  double width = 0.0;        ///< m, w at the deepest overlap
+  double overlap = 0.0;      ///< m, the deepest overlap
+  bool crushed = false;      ///< the cap was reached
+};
+CrushingPulse crushing_pulse(double impulse, double effective_mass, const CrushingLaw& law, const ContactWidth& width);
+/// The contact thickness of a body: a floe's thickness, an iceberg's draft plus sail height.
+double contact_thickness(const BodySpec& body);
+/// The nominal contact width's law at an impact: the spread of its points across the normal
+/// (`spread`), and where it is a point (spread below 1 % of the smaller body's size) the
+/// growth 2 tan(alpha / 2) of the sharper corner at `point` (the corner nearest the point,
+/// within that 1 %, of either body). Poses at the start of the impact step.
+ContactWidth contact_width_law(const BodySpec& a, Vec2 xa, double angle_a, const BodySpec& b, Vec2 xb, double angle_b,
+                               Vec2 point, double spread);
 
 /// m_eff = 1 / (n . M^-1 n) at a point; inverse mass and inertia 0 for a fixed body.
 double effective_mass(Vec2 normal, Vec2 r_a, double inv_mass_a, double inv_inertia_a, Vec2 r_b, double inv_mass_b,
@@ -110,6 +152,7 @@ class CollisionTracker {
     double peak_step_impulse = 0.0;  ///< measured: the largest step impulse
     Vec2 normal;                     ///< measured: for the restitution at separation
     Vec2 local_a, local_b;           ///< measured: the contact point in each body's frame
+    ContactWidth width;              ///< pressure_area: the nominal contact width's law
   };
   struct StepPair {
     std::int32_t a = 0, b = 0;
@@ -117,6 +160,8 @@ class CollisionTracker {
     Vec2 weighted_point, weighted_normal;
     double weighted_approach = 0.0;
     double impulse = 0.0;            ///< N s, all this step's normal impulses (measured model)
+    Vec2 tangent;                    ///< pressure_area: across the first point's normal
+    double spread_min = 0.0, spread_max = 0.0;  ///< pressure_area: the points along `tangent`
   };
   using PairKey = std::pair<std::int32_t, std::int32_t>;
   /// An event under way: its pair and its slot in events_ (ids, not the events, are merged).
@@ -132,6 +177,8 @@ class CollisionTracker {
   const Scene& scene_;
   double c_tau_ = 0.0, dt_ = 0.0, threshold_ = 0.0;
   DurationModel model_ = DurationModel::estimated;
+  bool crushing_ = false;  ///< contact.force_model = pressure_area
+  CrushingLaw crushing_law_;
   std::int64_t step_ = 0;
   // The step's pairs and the open events, each a list sorted by pair, merged in one pass each
   // step; their buffers are kept, so a step allocates nothing once they have grown (a std::map

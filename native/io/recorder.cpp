@@ -194,11 +194,13 @@ struct Recorder::Impl {
   std::vector<std::uint8_t> k_kind;
   H5::EnumType kind_type = contact_kind_type();
   // Collision events.
-  Series e_time, e_body_a, e_body_b, e_impulse, e_mass, e_approach, e_restitution, e_duration, e_mean, e_peak;
+  Series e_time, e_body_a, e_body_b, e_impulse, e_mass, e_approach, e_restitution, e_duration, e_mean, e_peak,
+      e_width, e_crushed;
   std::vector<CollisionRow> events;
   ContactOutput contact_output = ContactOutput::all;
   // Towing.
   bool tow = false;
+  bool crushing = false;  // contact.force_model = pressure_area: two more collision columns
   Series tow_time, tow_force, tow_force_mean, tow_ice_mean, tow_tug;
   std::vector<double> w_time, w_force, w_mean, w_ice, w_tug;
   // Contact loads.
@@ -256,6 +258,10 @@ struct Recorder::Impl {
         {&e_mean, "/contacts/collisions/mean_force", f64, {}, ke, &R::collisions},
         {&e_peak, "/contacts/collisions/peak_force", f64, {}, ke, &R::collisions},
     });
+    if (scene.contact.force_model == ContactSettings::ForceModel::pressure_area) {
+      t.push_back({&e_width, "/contacts/collisions/contact_width", f64, {}, ke, &R::collisions});
+      t.push_back({&e_crushed, "/contacts/collisions/crushed", H5::PredType::NATIVE_UINT8, {}, ke, &R::collisions});
+    }
     if (tow) {
       t.push_back({&tow_time, "/tow/time", f64, {}, kt, &R::tow});
       t.push_back({&tow_force, "/tow/force", f64, {2}, kt, &R::tow});
@@ -331,6 +337,10 @@ struct Recorder::Impl {
       column(e_duration, &CollisionRow::duration);
       column(e_mean, &CollisionRow::mean_force);
       column(e_peak, &CollisionRow::peak_force);
+      if (crushing) {
+        column(e_width, &CollisionRow::contact_width);
+        column(e_crushed, &CollisionRow::crushed);
+      }
       events.clear();
     }
   }
@@ -407,7 +417,23 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     d.contact_output = scene.output.contacts;
     H5::Group events = d.file.createGroup("/contacts/collisions");
     write_attribute(events, "duration_coefficient", scene.contact.duration_coefficient);
-    write_text(events, "duration_model", describe(duration_model_of(engine)), d.fixed_strings);
+    d.crushing = scene.contact.force_model == ContactSettings::ForceModel::pressure_area;
+    write_text(events, "duration_model",
+               d.crushing ? "estimated from the impulse: the pulse of the linear spring capped by the crushing force "
+                            "over the nominal contact area (docs/model.md 4)"
+                          : describe(duration_model_of(engine)),
+               d.fixed_strings);
+    if (d.crushing) {
+      // Only then, so that the linear model's files keep their bytes.
+      write_text(events, "force_model", "pressure_area", d.fixed_strings);
+      write_attribute(events, "crushing_coefficient", scene.contact.crushing_coefficient);
+      write_attribute(events, "crushing_width_exponent", scene.contact.crushing_width_exponent);
+      write_text(events, "crushing_thickness_exponent",
+                 scene.contact.has_crushing_thickness_exponent
+                     ? setting_text(scene.contact.crushing_thickness_exponent)
+                     : "min(-0.3, 0.2 h - 0.5), h in m (ISO 19906)",
+                 d.fixed_strings);
+    }
     if (scene.tow.mode != TowSpec::Mode::none) {
       d.tow = true;
       H5::Group tow = d.file.createGroup("/tow");
@@ -487,6 +513,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& r
     d.frame_chunk = frame_chunk_of(d.bodies);
     d.contact_output = scene.output.contacts;
     d.tow = scene.tow.mode != TowSpec::Mode::none;
+    d.crushing = scene.contact.force_model == ContactSettings::ForceModel::pressure_area;
     if (scene.geo.present) d.geo = std::make_unique<GeoProjection>(scene.geo);
     for (const Impl::Table& t : d.tables(scene)) {
       *t.series = Series(d.file.openDataSet(t.path), t.type);

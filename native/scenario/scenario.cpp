@@ -200,6 +200,24 @@ void read_contact(TableReader& root, Scene& scene) {
       r.real("duration_coefficient", scene.contact.duration_coefficient, Range::positive());
   if (r.has("stiffness"))
     scene.contact.duration_coefficient = M_PI / std::sqrt(r.real("stiffness", std::nullopt, Range::positive()));
+  // The collision force model (docs/model.md 4) and the crushing law's constants, which only
+  // the pressure-area model reads: given beside the linear model they would do nothing.
+  const bool crushing = r.string("force_model", "linear", {"linear", "pressure_area"}) == "pressure_area";
+  scene.contact.force_model = crushing ? ContactSettings::ForceModel::pressure_area : ContactSettings::ForceModel::linear;
+  for (const char* key : {"crushing_coefficient", "crushing_width_exponent", "crushing_thickness_exponent"})
+    if (!crushing && r.has(key)) r.fail(key, "only read with force_model = \"pressure_area\"");
+  // C_R from 0.1 to 50 MPa: from soft, warm sub-Arctic ice to the 25-50 MPa peaks Gagnon and
+  // Gammon (1997) measured on iceberg ice in the laboratory.
+  scene.contact.crushing_coefficient =
+      r.real("crushing_coefficient", scene.contact.crushing_coefficient, Range::closed(1e5, 5e7));
+  // Exponents in (-1, 0]: pressure that falls with area, but a force that still grows with it.
+  scene.contact.crushing_width_exponent =
+      r.real("crushing_width_exponent", scene.contact.crushing_width_exponent, Range::closed(-0.95, 0.0));
+  if (r.has("crushing_thickness_exponent")) {
+    scene.contact.crushing_thickness_exponent =
+        r.real("crushing_thickness_exponent", std::nullopt, Range::closed(-0.95, 0.0));
+    scene.contact.has_crushing_thickness_exponent = true;
+  }
   r.reject_unknown();
 }
 

@@ -22,6 +22,9 @@ class Job:
     priority: float = 0.0         # higher first (the report: its cost guess, longest first)
     after: list = field(default_factory=list)   # ids of jobs that must finish before it
     may_fail: bool = False        # a failure is an outcome (recorded, not retried)
+    stamp: str = ""               # what the job's result depends on beyond its command (a digest
+                                  # of the program and its inputs): a record with another stamp
+                                  # or command is not this job's, and the job runs again
 
 
 def _rule(job, index):
@@ -66,9 +69,32 @@ def write(jobs, workdir, label):
     return path, snakefile
 
 
+def forget_stale(jobs, workdir):
+    """Removes the records of jobs whose command or stamp has changed since they ran, so that a
+    list launched again reruns them rather than taking an old result for theirs. Returns the
+    ids whose records were removed."""
+    stale = []
+    for j in jobs:
+        for name in (j.id + ".json", j.id + ".failed.json"):
+            p = os.path.join(workdir, ".floedem", "done", name)
+            if not os.path.exists(p):
+                continue
+            try:
+                with open(p) as f:
+                    rec = json.load(f)
+            except (OSError, ValueError):
+                rec = {}
+            if rec.get("argv", j.argv) != j.argv or rec.get("stamp", "") != j.stamp:
+                os.remove(p)
+                stale.append(j.id)
+    return stale
+
+
 def launch(jobs, workdir, cores=None, profile=None, dry_run=False, label="launch", quiet=True):
-    """Runs the jobs not yet done; returns {id: record} for every job with a record (exit status,
-    wall time, error) and Snakemake's exit status."""
+    """Runs the jobs not yet done (a job whose command or stamp changed is not done); returns
+    {id: record} for every job with a record (exit status, wall time, error) and Snakemake's
+    exit status."""
+    forget_stale(jobs, workdir)
     _, snakefile = write(jobs, workdir, label)
     cores = cores or len(os.sched_getaffinity(0))
     args = [sys.executable, "-m", "snakemake", "--snakefile", snakefile, "--directory", os.path.abspath(workdir),
@@ -111,7 +137,7 @@ def run_one(launch_json, job_id, threads):
     p = subprocess.run(job["argv"], capture_output=True, text=True, env=env)
     seconds = time.monotonic() - t0
     record = dict(returncode=p.returncode, seconds=seconds, error=(p.stderr or p.stdout).strip()[-2000:]
-                  if p.returncode else "")
+                  if p.returncode else "", argv=job["argv"], stamp=job.get("stamp", ""))
     ok = p.returncode == 0
     target = os.path.join(done, job_id + (".json" if ok or job["may_fail"] else ".failed.json"))
     write_atomic(target, json.dumps(record))

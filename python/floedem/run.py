@@ -21,6 +21,8 @@ _CONTACTS = {"time": (), "body_a": (), "body_b": (), "point": (2,), "normal": (2
 _COLLISIONS = {"time": (), "body_a": (), "body_b": (), "normal_impulse": (), "effective_mass": (),
                "approach_speed": (), "restitution_achieved": (), "duration": (), "mean_force": (),
                "peak_force": ()}
+# With [contact] force_model = "pressure_area" (the group's attribute force_model says so).
+_COLLISIONS_CRUSHING = {"contact_width": (), "crushed": ()}
 _TOW = {"time": (), "force": (2,), "force_mean": (2,), "ice_force_mean": (2,), "tug_position": (2,)}
 _LOADS = {"time": (), "force": ("B", 2)}
 
@@ -147,7 +149,11 @@ class Run:
             raise self._error("/bodies/position", f"has {len(frames)} frames; /time has {len(self.time)}")
         self._frames = frames
         self.contacts = Table(self, "contacts", _CONTACTS, {}) if "contacts/time" in f else None
-        self.collisions = Table(self, "contacts/collisions", _COLLISIONS, {}) if "contacts/collisions/time" in f else None
+        self.collisions = None
+        if "contacts/collisions/time" in f:
+            crushing = _attrs(f["contacts/collisions"]).get("force_model") == "pressure_area"
+            self.collisions = Table(self, "contacts/collisions",
+                                    dict(_COLLISIONS, **(_COLLISIONS_CRUSHING if crushing else {})), {})
         self.tow = Table(self, "tow", _TOW, {}) if "tow/time" in f else None
         if "loads/time" in f:
             b = f["loads/body"][()] if "body" in f["loads"] else None

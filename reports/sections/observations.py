@@ -91,10 +91,15 @@ CAUSES = {
                       "2 and 5 km). The compliant references let go at about 0.75 tau (their dashpot).",
     "hans_peak": "the compliant references' dashpot adds to the force at first touch, about doubling the peak of "
                  "the same impulse; native's half-sine estimate is the model's figure.",
+    "gagnon_peak_native_pa": "the crushing force is taken over the nominal area, the contact width times the "
+                             "thinner body's full thickness (the ship's 8.3 m draft): the bow's rake and the bit's "
+                             "irregular face meet over far less, and the panel carried only part of the bow's load.",
+    "gagnon_duration_native_pa": "a pulse capped by crushing is longer the heavier the bit: the 22 000 t bits' "
+                                 "pulses last seconds where the panel saw at most 0.6 s.",
     "gagnon_peak": "one linear contact stiffness for every scale (4.4e8 N/m, set from kilometre-scale floes): a "
                    "bergy bit crushes over a small, growing contact area, a far softer contact, and the panel "
-                   "carried only part of the bow's load. A stiffness that grows with the contact's size (a "
-                   "pressure-area law) would give longer, weaker pulses at small masses.",
+                   "carried only part of the bow's load. The pressure-area model's rows show the crushing limit's "
+                   "effect.",
     "gagnon_duration": "the same single stiffness: the light bits' pulses are shorter than observed.",
     "tow_open_water": "the icebergs and speeds of the tows are not published with their forces.",
     "rotation_mean": "the observers name the periodic tidal current as what turns icebergs; the scene's wind is "
@@ -111,6 +116,10 @@ ICE_DENSITY = 900.0
 WEBER_SIDES = {2.0: "2 km", 3.0: "3 km (the scene)", 5.0: "5 km"}   # floe diameter, km
 HANS_SIDES = {1.0: "1 km", 1.5: "1.5 km (the scene)", 2.0: "2 km"}
 TOW_SPEEDS = [0.25, 0.5]         # m/s
+# The collision force models (docs/model.md 4): the paper's linear one, the default, and the
+# crushing-limited pressure-area one, each with its own defaults (one parameter set each).
+MODEL_SUFFIX = {"linear": "", "pressure_area": "_pa"}
+MODEL_LABEL = {"linear": "linear", "pressure_area": "pressure-area"}
 TOW_RAMP = 300.0                 # s
 
 
@@ -153,16 +162,20 @@ def disc_square(d):
     return d * math.sqrt(math.pi) / 2.0
 
 
-def collision_run(ctx, tag, name, engine, m_eff, speed, sets, meta):
+def collision_run(ctx, tag, name, engine, m_eff, speed, sets, meta, model="linear"):
     """A Run of a collision scene on `engine` (compliant on ODE and Bullet), dt = tau / 40 for the
-    default C_tau, long enough to close the scene's gap and hold four pulses."""
+    default C_tau, long enough to close the scene's gap and hold four pulses; on native, with
+    the collision force model `model` (docs/model.md 4: the impulses, so the steps, are the
+    same on both; only the pulse made from them differs)."""
     tau = meta.get("c_tau", C_TAU) * math.sqrt(m_eff)
     gap_time = meta.get("gap", 0.5) / speed
     sets = list(sets) + [f"run.dt={tau / STEPS_PER_PULSE!r}", f"run.duration={gap_time + 4.0 * tau!r}"]
     if engine in COMPLIANT:
         sets.append(f"engine.{engine}.contact_model=compliant")
-    return Run(f"obs_{tag}_{engine}", scenario(ctx, name), engine, sets, cost=0.05,
-               meta=dict(part="collision", engine=engine, **meta))
+    if model != "linear":
+        sets.append(f"contact.force_model={model}")
+    return Run(f"obs_{tag}_{engine}{MODEL_SUFFIX[model]}", scenario(ctx, name), engine, sets, cost=0.05,
+               meta=dict(part="collision", engine=engine, model=model, **meta))
 
 
 def plan(ctx):
@@ -190,6 +203,8 @@ def plan(ctx):
         for e in (engines if d == 3.0 else ["native"]):
             runs.append(collision_run(ctx, f"weber_d{d:g}", "collision_weber", e, 0.5 * m, 0.05, sets,
                                       dict(case="weber", diameter=d, gap=0.5)))
+        runs.append(collision_run(ctx, f"weber_d{d:g}", "collision_weber", "native", 0.5 * m, 0.05, sets,
+                                  dict(case="weber", diameter=d, gap=0.5), model="pressure_area"))
     for ct in C_TAUS:
         s = disc_square(3000.0)
         runs.append(collision_run(ctx, f"weber_c{ct:g}", "collision_weber", "native", 0.5 * ICE_DENSITY * 3.0 * s * s,
@@ -203,6 +218,9 @@ def plan(ctx):
             runs.append(collision_run(ctx, f"hans_d{d:g}", "collision_hans_island", e, m, 0.5,
                                       [f"body[0].polygon={square(s, -600.5 - 1.0 - s)}"],
                                       dict(case="hans", diameter=d, gap=1.0)))
+        runs.append(collision_run(ctx, f"hans_d{d:g}", "collision_hans_island", "native", m, 0.5,
+                                  [f"body[0].polygon={square(s, -600.5 - 1.0 - s)}"],
+                                  dict(case="hans", diameter=d, gap=1.0), model="pressure_area"))
     for ct in C_TAUS:
         s = disc_square(1500.0)
         runs.append(collision_run(ctx, f"hans_c{ct:g}", "collision_hans_island", "native", ICE_DENSITY * 6.0 * s * s,
@@ -217,6 +235,8 @@ def plan(ctx):
             for e in engines:
                 runs.append(collision_run(ctx, f"gagnon_m{m / 1e3:g}t_v{v:g}", "collision_gagnon", e, m_eff, v, sets,
                                           dict(case="gagnon", mass=m, speed=v, gap=0.5)))
+            runs.append(collision_run(ctx, f"gagnon_m{m / 1e3:g}t_v{v:g}", "collision_gagnon", "native", m_eff, v,
+                                      sets, dict(case="gagnon", mass=m, speed=v, gap=0.5), model="pressure_area"))
             if m == GAGNON_MASSES[-1] and v == GAGNON_SPEEDS[-1]:
                 for ct in C_TAUS:
                     runs.append(collision_run(ctx, f"gagnon_m{m / 1e3:g}t_v{v:g}_c{ct:g}", "collision_gagnon", "native",
@@ -294,8 +314,11 @@ def read_collision(run):
         g = f.collisions
         if len(g) != 1:
             raise RuntimeError(f"{run.out}: {len(g)} collision events, expected 1")
-        return {k: float(getattr(g, k)[0]) for k in ("duration", "peak_force", "effective_mass", "normal_impulse",
-                                                     "approach_speed")}
+        out = {k: float(getattr(g, k)[0]) for k in ("duration", "peak_force", "effective_mass", "normal_impulse",
+                                                    "approach_speed")}
+        if hasattr(g, "contact_width"):   # the pressure-area model's
+            out.update(contact_width=float(g.contact_width[0]), crushed=bool(g.crushed[0]))
+        return out
 
 
 def read_tow(run):
@@ -463,18 +486,22 @@ def write(ctx):
     for r in ctx.all_runs:
         if r.meta.get("part") == "collision":
             col[r.tag] = dict(read_collision(r), **r.meta)
-    for e in engines:
-        w = col[f"obs_weber_d3_{e}"]
-        row(f"weber_duration_{e}", "2 Weber 1972", "duration (s)", w["duration"], f"{w['duration']:.1f}",
-            "weber_duration", e)
-        h = col[f"obs_hans_d1.5_{e}"]
-        row(f"hans_peak_{e}", "2 Hans Island", "peak force, direct hit (MN)", h["peak_force"],
-            si(h["peak_force"], 1e6), "hans_peak", e)
-        g = [col[f"obs_gagnon_m{m / 1e3:g}t_v{v:g}_{e}"] for m in GAGNON_MASSES for v in GAGNON_SPEEDS]
+    # Native on both force models (the row's engine says which; the pressure-area rows' ids end
+    # in _pa), the compliant references on their own springs.
+    for e, model in [(e, "linear") for e in engines] + [("native", "pressure_area")]:
+        x = MODEL_SUFFIX[model]
+        label = e if model == "linear" else f"{e}, {MODEL_LABEL[model]}"
+        w = col[f"obs_weber_d3_{e}{x}"]
+        row(f"weber_duration_{e}{x}", "2 Weber 1972", "duration (s)", w["duration"], f"{w['duration']:.1f}",
+            "weber_duration", label)
+        h = col[f"obs_hans_d1.5_{e}{x}"]
+        row(f"hans_peak_{e}{x}", "2 Hans Island", "peak force, direct hit (MN)", h["peak_force"],
+            si(h["peak_force"], 1e6), "hans_peak", label)
+        g = [col[f"obs_gagnon_m{m / 1e3:g}t_v{v:g}_{e}{x}"] for m in GAGNON_MASSES for v in GAGNON_SPEEDS]
         dur = (min(x["duration"] for x in g), max(x["duration"] for x in g))
         peak = (min(x["peak_force"] for x in g), max(x["peak_force"] for x in g))
-        row(f"gagnon_duration_{e}", "2 Gagnon 2008", "duration (s)", dur, fmt(dur), "gagnon_duration", e)
-        row(f"gagnon_peak_{e}", "2 Gagnon 2008", "peak force (MN)", peak, si(peak, 1e6), "gagnon_peak", e)
+        row(f"gagnon_duration_{e}{x}", "2 Gagnon 2008", "duration (s)", dur, fmt(dur), "gagnon_duration", label)
+        row(f"gagnon_peak_{e}{x}", "2 Gagnon 2008", "peak force (MN)", peak, si(peak, 1e6), "gagnon_peak", label)
 
     # Case 3: towing in open water.
     tow = {(v, cw): read_tow(ctx.run(f"obs_tow_v{v:g}_cw{cw:g}")) for v in TOW_SPEEDS for cw in [0.9] + WATER_FORM}
@@ -591,48 +618,71 @@ def write(ctx):
            "suite above, not a disagreement. The Weber and Hans Island figures are the ones the default C_tau was "
            "chosen from (docs/model.md 4): they check the scene and the default against each other. The bergy "
            "bits were not: they test the sqrt(m_eff) law five orders of magnitude lower in mass.", "",
-           "| case | condition | C_tau | m_eff (kg) | duration (s) | peak force (MN) | file |",
-           "|---|---|---|---|---|---|---|"]
+           "The pressure-area model (`contact.force_model = \"pressure_area\"`, docs/model.md 4) makes its pulse "
+           "from the same impulse with the spring's force capped by the ice's crushing pressure over the nominal "
+           "contact area (ISO 19906's global relation, C_R = 2.5 MPa): its rows below are native's runs of the same "
+           "scenes with that one key changed, every other coefficient at its default. The contact width at the "
+           "peak says where the cap acts: a face on a face (Weber's floes, the floe on the island) starts wide and "
+           "is not capped; the ship's stem is a corner whose width grows from nothing.", "",
+           "| case | condition | force model | C_tau | m_eff (kg) | duration (s) | peak force (MN) | contact width at "
+           "the peak (m) | file |",
+           "|---|---|---|---|---|---|---|---|---|"]
 
     def col_row(case, cond, ct, tag):
         x = col[tag]
-        md.append(f"| {case} | {cond} | {ct:g}{' (default)' if ct == C_TAU else ''} | {x['effective_mass']:.3g} | "
-                  f"{x['duration']:.3g} | {x['peak_force'] / 1e6:.3g} | `runs/{tag}.h5` |")
+        model = x.get("model", "linear")
+        width = f"{x['contact_width']:.3g}{' (crushed)' if x['crushed'] else ''}" if "contact_width" in x else "-"
+        md.append(f"| {case} | {cond} | {MODEL_LABEL[model]} | {ct:g}{' (default)' if ct == C_TAU else ''} | "
+                  f"{x['effective_mass']:.3g} | {x['duration']:.3g} | {x['peak_force'] / 1e6:.3g} | {width} | "
+                  f"`runs/{tag}.h5` |")
 
-    for d, label in WEBER_SIDES.items():
-        col_row("Weber", f"floes {label} across, 0.05 m/s", C_TAU, f"obs_weber_d{d:g}_native")
+    for x in MODEL_SUFFIX.values():
+        for d, label in WEBER_SIDES.items():
+            col_row("Weber", f"floes {label} across, 0.05 m/s", C_TAU, f"obs_weber_d{d:g}_native{x}")
     for ct in C_TAUS:
         col_row("Weber", "floes 3 km across, 0.05 m/s", ct, f"obs_weber_c{ct:g}_native")
-    for d, label in HANS_SIDES.items():
-        col_row("Hans Island", f"floe {label} across, 6 m, 0.5 m/s", C_TAU, f"obs_hans_d{d:g}_native")
+    for x in MODEL_SUFFIX.values():
+        for d, label in HANS_SIDES.items():
+            col_row("Hans Island", f"floe {label} across, 6 m, 0.5 m/s", C_TAU, f"obs_hans_d{d:g}_native{x}")
     for ct in C_TAUS:
         col_row("Hans Island", "floe 1.5 km across, 6 m, 0.5 m/s", ct, f"obs_hans_c{ct:g}_native")
-    for m in GAGNON_MASSES:
-        for v in GAGNON_SPEEDS:
-            col_row("Gagnon", f"{m / 1e3:g} t at {v:g} m/s", C_TAU, f"obs_gagnon_m{m / 1e3:g}t_v{v:g}_native")
+    for x in MODEL_SUFFIX.values():
+        for m in GAGNON_MASSES:
+            for v in GAGNON_SPEEDS:
+                col_row("Gagnon", f"{m / 1e3:g} t at {v:g} m/s", C_TAU, f"obs_gagnon_m{m / 1e3:g}t_v{v:g}_native{x}")
     for ct in C_TAUS:
         m, v = GAGNON_MASSES[-1], GAGNON_SPEEDS[-1]
         col_row("Gagnon", f"{m / 1e3:g} t at {v:g} m/s", ct, f"obs_gagnon_m{m / 1e3:g}t_v{v:g}_c{ct:g}_native")
     w3 = col["obs_weber_d3_native"]
+
+    def gagnon_span(suffix, key):
+        g = [col[f"obs_gagnon_m{m / 1e3:g}t_v{v:g}_native{suffix}"][key] for m in GAGNON_MASSES for v in GAGNON_SPEEDS]
+        return min(g), max(g)
+    pa_peak, lin_peak = gagnon_span("_pa", "peak_force"), gagnon_span("", "peak_force")
+    pa_dur, lin_dur = gagnon_span("_pa", "duration"), gagnon_span("", "duration")
     md += ["",
            f"The struck station floe gains {w3['normal_impulse'] / (2.0 * w3['effective_mass']):.4f} m/s "
            "(Weber: 0.023 to 0.033 m/s); the scene's approach speed was chosen to give the middle of that range, so "
            "this checks the scene, not the model. The duration, which the model predicts, reaches 20 s at the default "
            f"C_tau for floes of {3.0 * 20.0 / w3['duration']:.1f} km (it goes as the floes' diameter, the square "
-           "root of their mass), and the floes' size is not published with the event. The bergy bits' peak "
-           "forces exceed the largest measured (2.4 MN, on an "
-           "instrumented panel of the bow) by far: one linear contact stiffness (4.4e8 N/m) for every scale is the "
-           "model's assumption that fails here. A bergy bit crushes over a small, growing contact area, a much "
-           "softer contact than the kilometre-scale floes the default was set from, and the panel carried only "
-           "part of the bow's load; a stiffness that grows with the contact's size (a pressure-area law) would give "
-           "longer, weaker pulses for small masses.", ""]
+           "root of their mass), and the floes' size is not published with the event. On the linear model the "
+           "bergy bits' peak forces exceed the largest measured (2.4 MN, on an instrumented panel of the bow) by "
+           "far: one contact stiffness (4.4e8 N/m) for every scale, set from kilometre-scale floes, where a bergy "
+           "bit crushes over a small, growing area. The pressure-area model caps the stem's force by that "
+           f"crushing: peaks of {pa_peak[0] / 1e6:.3g} to {pa_peak[1] / 1e6:.3g} MN against the linear model's "
+           f"{lin_peak[0] / 1e6:.3g} to {lin_peak[1] / 1e6:.3g}, and pulses of {pa_dur[0]:.2g} to {pa_dur[1]:.2g} s "
+           f"against {lin_dur[0]:.2g} to {lin_dur[1]:.2g}, with the Weber and Hans Island figures unchanged (their "
+           "faces meet wide).", ""]
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.8), constrained_layout=True)
     marks = {"native": "o", "ode": "s", "bullet": "^"}
-    for e in engines:
-        xs = [x for x in col.values() if x["engine"] == e and "c_tau" not in x]
-        axes[0].loglog([x["effective_mass"] for x in xs], [x["duration"] for x in xs], marks[e], mfc="none", label=e)
+    for e, model in [(e, "linear") for e in engines] + [("native", "pressure_area")]:
+        xs = [x for x in col.values() if x["engine"] == e and x["model"] == model and "c_tau" not in x]
+        mark = marks[e] if model == "linear" else "x"
+        label = e if model == "linear" else f"{e}, {MODEL_LABEL[model]}"
+        axes[0].loglog([x["effective_mass"] for x in xs], [x["duration"] for x in xs], mark, mfc="none", label=label)
         xs = [x for x in xs if x["case"] != "weber"]   # Weber's event has no measured force
-        axes[1].loglog([x["effective_mass"] for x in xs], [x["peak_force"] for x in xs], marks[e], mfc="none", label=e)
+        axes[1].loglog([x["effective_mass"] for x in xs], [x["peak_force"] for x in xs], mark, mfc="none",
+                       label=label)
     mg = np.logspace(4.5, 10.5, 50)
     axes[0].loglog(mg, C_TAU * np.sqrt(mg), "k--", lw=0.8, label="C_tau sqrt(m_eff), default")
     g_meff = [SHIP_MASS * m / (SHIP_MASS + m) for m in GAGNON_MASSES]

@@ -235,6 +235,24 @@ TEST_CASE("resume: a geographic run killed and continued gives the uninterrupted
   fs::remove_all(f.dir);
 }
 
+TEST_CASE("resume: a run on the pressure-area force model killed and continued is the same file", "[resume]") {
+  // Its open collision events carry their contact width's law through the checkpoint.
+  std::string text = kScenario;
+  const std::string friction = "friction = 0.3\n";
+  REQUIRE(text.find(friction) != std::string::npos);
+  text.insert(text.find(friction) + friction.size(), "force_model = \"pressure_area\"\n");
+  const Files f = write_scenario("crushing", text);
+  REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+  REQUIRE(whole.count("/contacts/collisions/contact_width"));
+  REQUIRE(test::run_cli(run_args(f, "cut.h5"), "FLOEDEM_TEST_KILL_AT_STEP=777 ").code != 0);
+  const auto resumed = test::run_cli("run --resume " + (f.dir / "cut.h5").string());
+  INFO(resumed.output);
+  REQUIRE(resumed.code == 0);
+  check_same_contents(whole, f.dir / "cut.h5");
+  fs::remove_all(f.dir);
+}
+
 TEST_CASE("resume: killed twice, and a damaged checkpoint falls back to the other slot", "[resume]") {
   const Files f = write_scenario("twice");
   REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);

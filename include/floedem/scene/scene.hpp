@@ -36,6 +36,21 @@ struct ContactSettings {
   /// 1.4e-4; Weber's station floe (of order 1e10 kg, m_eff ~ 5e9) accelerated over 20-40 s,
   /// C_tau ~ 1.3e-4 to 5e-4. Equivalent linear contact stiffness k = (pi / C_tau)^2 = 4.4e8 N/m.
   double duration_coefficient = 1.5e-4;
+  /// How a collision's duration and peak force are found from its impulse (docs/model.md 4):
+  /// `linear` (the paper's: a half-sine of duration C_tau sqrt(m_eff)) or `pressure_area`
+  /// (the same spring, its force capped by the ice's crushing pressure over the nominal contact
+  /// area). Neither changes the impulses, so every motion is the same under both.
+  enum class ForceModel : std::uint8_t { linear, pressure_area };
+  ForceModel force_model = ForceModel::linear;
+  /// pressure_area: the global crushing pressure of ISO 19906 (2010), A.8.2.4.3.3,
+  ///   p = C_R (h / 1 m)^n (w / h)^m,   n = min(-0.3, 0.2 h / 1 m - 0.5)  (when not given),
+  /// over the area w h (w: contact width, h: the thinner body's thickness). C_R: 2.5 MPa, the
+  /// pressure Gagnon et al. (2008) measured in the pulverised ice that carried the load of bergy
+  /// bits struck by CCGS Terry Fox; m = -0.16 (ISO 19906's width exponent).
+  double crushing_coefficient = 2.5e6;     ///< C_R, Pa
+  double crushing_width_exponent = -0.16;  ///< m
+  double crushing_thickness_exponent = 0.0;///< n when given (has_crushing_thickness_exponent)
+  bool has_crushing_thickness_exponent = false;
 };
 
 enum class ContactOutput : std::uint8_t { all, collisions, none };
