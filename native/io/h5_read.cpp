@@ -122,11 +122,16 @@ std::int64_t CheckedFile::string_format() const {
 
 std::string CheckedFile::text_attribute(const std::string& name, bool required) const {
   if (!required && !H5::Group(file_.openGroup("/")).attrExists(name)) return {};
-  H5::Attribute a = scalar_attribute("/", name, H5T_STRING);
+  return text_attribute("/", name);
+}
+
+std::string CheckedFile::text_attribute(const std::string& object, const std::string& name) const {
+  H5::Attribute a = scalar_attribute(object, name, H5T_STRING);
   const H5::StrType type = a.getStrType();
+  const std::string where = object == "/" ? "/@" + name : object + "@" + name;
   if (fixed_strings() && type.isVariableStr())
-    fail("/@" + name, "holds a variable-length string; format " + std::to_string(string_format()) +
-                          " stores fixed-length ones: damaged, or not written by floedem");
+    fail(where, "holds a variable-length string; format " + std::to_string(string_format()) +
+                    " stores fixed-length ones: damaged, or not written by floedem");
   std::string v;
   a.read(type, v);
   return v;

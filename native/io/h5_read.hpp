@@ -45,6 +45,8 @@ class CheckedFile {
   /// A scalar string attribute of the root; empty when absent and !required. Of format 2 on,
   /// a variable-length one is refused unread (it would be read from the global heap).
   std::string text_attribute(const std::string& name, bool required) const;
+  /// A string attribute of `object` (a group or dataset path); required.
+  std::string text_attribute(const std::string& object, const std::string& name) const;
   /// A scalar numeric attribute of `object` (a group or dataset path).
   double real_attribute(const std::string& object, const std::string& name) const;
   std::int64_t integer_attribute(const std::string& object, const std::string& name) const;

@@ -137,6 +137,13 @@ StoredRun read_stored_run(H5::H5File& file, const std::string& label) {
       if (end > at) run.overrides.push_back(overrides.substr(at, end - at));
       at = end + 1;
     }
+    if (f.exists("/inputs")) {
+      H5::Group inputs = file.openGroup("/inputs");
+      for (int k = 0; k < inputs.getNumAttrs(); ++k) {
+        const std::string name = inputs.openAttribute(static_cast<unsigned>(k)).getName();
+        run.inputs[name] = f.text_attribute("/inputs", name);
+      }
+    }
     std::vector<hsize_t> dims;
     run.mass = f.reals("/bodies/mass", {-1}, dims);
     for (std::size_t i = 0; i < run.mass.size(); ++i)

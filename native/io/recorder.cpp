@@ -455,6 +455,10 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
     }
     d.frame_chunk = frame_chunk_of(n);
     for (const Impl::Table& t : d.tables(scene)) *t.series = Series(root, t.path, t.type, t.row_shape, t.chunk);
+    if (!scene.input_files.empty()) {  // only then: a scene that reads no file keeps its bytes
+      H5::Group inputs = d.file.createGroup("/inputs");
+      for (const InputFile& f : scene.input_files) write_text(inputs, f.key, f.text(), d.fixed_strings);
+    }
     for (const Provenance& p : scene.provenance) {
       H5::Group g = d.file.createGroup(p.group);
       for (const auto& [k, v] : p.text) write_text(g, k, v, d.fixed_strings);

@@ -56,6 +56,20 @@ ResumeResult resume_run(const std::string& path, const std::vector<std::string>&
   if (!same_bodies)
     throw InputError(stored + ": its scenario (" + run.scenario_path +
                      ") no longer gives the run's bodies: has a file it reads (a field) changed?");
+  // Every file the run read (forcing files, a field, a chart) must be as it was: a changed one
+  // would continue another run under this one's name. (A file written before floedem recorded
+  // its inputs has no /inputs: nothing to hold it to.)
+  for (const InputFile& f : scene.input_files) {
+    const auto it = run.inputs.find(f.key);
+    if (it == run.inputs.end()) {
+      if (run.inputs.empty()) break;
+      throw InputError(stored + ": " + f.key + " (" + f.path + ") was not read by the run; the scenario has changed");
+    }
+    if (it->second != f.text())
+      throw InputError(input_message(f.path, 0, f.key,
+                                     "has changed since the run read it (the run recorded " + it->second + "; now " +
+                                         f.text() + "): restore it, or start the run afresh"));
+  }
 
   if (run.status == "complete" && stored == final_path && scene.run.duration == run.duration) {
     result.message = final_path + ": the run is complete (" + setting_text(run.duration) +

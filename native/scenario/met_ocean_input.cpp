@@ -11,6 +11,7 @@
 
 #include "floedem/scene/input_error.hpp"
 #include "io/netcdf_grid.hpp"
+#include "scenario/input_file.hpp"
 #include "scene/calendar.hpp"
 
 namespace floedem {
@@ -75,7 +76,7 @@ void read_tides(TableReader& env, Scene& scene) {
   }
 }
 
-bool read_velocity_file(TableReader& env, std::string_view key, const Scene& scene, VelocitySeries& series,
+bool read_velocity_file(TableReader& env, std::string_view key, Scene& scene, VelocitySeries& series,
                         FlowGridSpec& grid) {
   const toml::table* t = env.table(key);
   if (!t) return false;
@@ -91,6 +92,7 @@ bool read_velocity_file(TableReader& env, std::string_view key, const Scene& sce
   if (extension == ".nc") {
     if (!std::filesystem::is_regular_file(path)) r.fail("file", "cannot open '" + name + "': no such file");
     grid = inspect_flow_grid(name, u_name, v_name, scene.run, scene.geo);
+    record_input_file(scene, "environment." + std::string(key) + ".file", name);
     return true;
   }
   std::ifstream in(name);
@@ -157,6 +159,7 @@ bool read_velocity_file(TableReader& env, std::string_view key, const Scene& sce
                                      return d.str();
                                    }() + " s (run.duration: the series must cover the run)"));
   }
+  record_input_file(scene, "environment." + std::string(key) + ".file", name);
   return true;
 }
 

@@ -19,8 +19,8 @@ void read_tides(TableReader& env_reader, Scene& scene);
 /// `series`: a CSV file with a column `time` (s from the run's start) and the velocity's x and
 /// y columns (named by the table's u and v, default "u" and "v"), covering [0, run.duration];
 /// or into `grid`, a CF-NetCDF file's axes (io/netcdf_grid.hpp). Returns whether the table
-/// was there.
-bool read_velocity_file(TableReader& env_reader, std::string_view key, const Scene& scene, VelocitySeries& series,
+/// was there; the file read is added to scene.input_files.
+bool read_velocity_file(TableReader& env_reader, std::string_view key, Scene& scene, VelocitySeries& series,
                         FlowGridSpec& grid);
 
 /// The plane's lattice of each grid on longitude and latitude (FlowGridSpec::lonlat): InputError

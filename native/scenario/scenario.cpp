@@ -16,6 +16,7 @@
 #include "geometry/polygon.hpp"
 #include "floedem/io/output.hpp"
 #include "floedem/scene/geo.hpp"
+#include "scenario/input_file.hpp"
 #include "scenario/met_ocean_input.hpp"
 #include "scenario/table_reader.hpp"
 #include "floedem/scene/input_error.hpp"
@@ -526,6 +527,7 @@ void read_field(TableReader& root, Scene& scene, double ice_density, const DragC
     } catch (const InputError& e) {
       r.fail("file", e.what());
     }
+    record_input_file(scene, "field.file", file.string());
     for (std::size_t i = 0; i < bodies.polygons.size(); ++i) {
       if (bodies.fixed[i]) continue;  // structures of a run's output stay behind
       BodySpec b;
@@ -556,6 +558,7 @@ void read_field(TableReader& root, Scene& scene, double ice_density, const DragC
     } catch (const FieldSpecError& e) {
       r.fail("chart", e.what());
     }
+    record_input_file(scene, "field.chart", file.string());
     floes = field_floes(field, density, prefix);
     for (Provenance& p : chart_provenance(field, chart, stats, spec, density, scene.bodies.size()))
       scene.provenance.push_back(std::move(p));

@@ -94,7 +94,8 @@ class Run:
     the file has none), summary (the summary_* attributes without the prefix), engine_info
     (/engine's attributes), provenance ({group: attributes}, e.g. "field"); a geographic
     scene's run (docs/geography.md) also geo (/geo's attributes: origin_lon, origin_lat,
-    projection; None for a scene in plain metres) and lonlat [T, N, 2] (deg)."""
+    projection; None for a scene in plain metres) and lonlat [T, N, 2] (deg); inputs ({scenario
+    key: "fnv1a64 DIGEST, N bytes, PATH"} for the files the scenario read, {} if none)."""
 
     def __init__(self, path):
         self.path = os.fspath(path)
@@ -154,6 +155,8 @@ class Run:
             crushing = _attrs(f["contacts/collisions"]).get("force_model") == "pressure_area"
             self.collisions = Table(self, "contacts/collisions",
                                     dict(_COLLISIONS, **(_COLLISIONS_CRUSHING if crushing else {})), {})
+        # The files the scenario read, by scenario key: "fnv1a64 DIGEST, N bytes, PATH" ({} if none).
+        self.inputs = _attrs(f["inputs"]) if "inputs" in f else {}
         self.tow = Table(self, "tow", _TOW, {}) if "tow/time" in f else None
         if "loads/time" in f:
             b = f["loads/body"][()] if "body" in f["loads"] else None

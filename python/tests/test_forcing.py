@@ -50,6 +50,13 @@ def test_a_grid_uniform_in_space_drives_the_run_its_record_does(tmp_path):
     assert np.linalg.norm(by_record[0]) > 100.0  # it drifted
     assert np.array_equal(by_record, by_grid)
     assert not os.path.exists(str(tmp_path / "ocean.nc.partial"))
+    # Each run records the file it read: its size and digest, so an archived run says what it
+    # was made from.
+    for name, file in (("record", "current.csv"), ("grid", "ocean.nc")):
+        with floedem.open(str(tmp_path / f"{name}.h5")) as f:
+            rec = f.inputs["environment.current_file.file"]
+        size = os.path.getsize(tmp_path / file)
+        assert rec.startswith("fnv1a64 ") and f", {size} bytes, " in rec and rec.endswith(file), rec
 
 
 def test_bad_arrays_are_refused_naming_the_argument(tmp_path):

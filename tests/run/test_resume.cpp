@@ -15,6 +15,7 @@
 #include "floedem/engine/registry.hpp"
 #include "io/recorder.hpp"
 #include "run/stepper.hpp"
+#include "floedem/engine/state_io.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -250,6 +251,46 @@ TEST_CASE("resume: a run on the pressure-area force model killed and continued i
   INFO(resumed.output);
   REQUIRE(resumed.code == 0);
   check_same_contents(whole, f.dir / "cut.h5");
+  fs::remove_all(f.dir);
+}
+
+TEST_CASE("resume: a forcing file changed since the run read it is refused; unchanged, continued", "[resume]") {
+  std::string text = kScenario;
+  const std::string wind = "wind = [6.0, -2.0]\n";
+  REQUIRE(text.find(wind) != std::string::npos);
+  text.erase(text.find(wind), wind.size());
+  const Files f = write_scenario("inputs", text + "[environment.wind_file]\nfile = \"wind.csv\"\n");
+  const std::string record = "time,u,v\n0,6,-2\n30,5,-1\n60,6,-2\n";
+  std::ofstream(f.dir / "wind.csv") << record;
+  REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+  // The record: FNV-1a of the file's bytes, its size and path.
+  const std::uint64_t digest =
+      state_checksum(reinterpret_cast<const std::uint8_t*>(record.data()), record.size());
+  char expected[64];
+  std::snprintf(expected, sizeof expected, "fnv1a64 %016llx, %zu bytes, ", static_cast<unsigned long long>(digest),
+                record.size());
+  REQUIRE(whole.count("/inputs@environment.wind_file.file"));
+  CHECK(whole.at("/inputs@environment.wind_file.file").find(expected) != std::string::npos);
+  for (const bool change : {true, false}) {
+    INFO("file changed: " << change);
+    fs::remove(f.dir / "cut.h5");
+    std::ofstream(f.dir / "wind.csv") << record;
+    REQUIRE(test::run_cli(run_args(f, "cut.h5"), "FLOEDEM_TEST_KILL_AT_STEP=777 ").code != 0);
+    std::ofstream(f.dir / "wind.csv") << (change ? "time,u,v\n0,6,-2\n30,5,-1.5\n60,6,-2\n" : record);
+    const auto resumed = test::run_cli("run --resume " + (f.dir / "cut.h5").string());
+    INFO(resumed.output);
+    if (change) {
+      CHECK(resumed.code == 2);
+      CHECK(resumed.output.find("environment.wind_file.file") != std::string::npos);
+      CHECK(resumed.output.find("has changed since the run read it") != std::string::npos);
+      CHECK(fs::exists(f.dir / "cut.h5.partial"));  // left as it was, for a continuation once restored
+      fs::remove(f.dir / "cut.h5.partial");
+    } else {
+      REQUIRE(resumed.code == 0);
+      check_same_contents(whole, f.dir / "cut.h5");
+    }
+  }
   fs::remove_all(f.dir);
 }
 

@@ -106,9 +106,9 @@ class StateReader {
   std::size_t at_ = 0;
 };
 
-/// FNV-1a, 64 bits: tells a checkpoint written whole from one cut short by a kill.
-inline std::uint64_t state_checksum(const std::uint8_t* p, std::size_t n) {
-  std::uint64_t h = 14695981039346656037ull;
+/// FNV-1a, 64 bits: tells a checkpoint written whole from one cut short by a kill, and an input
+/// file from one changed since a run read it. `h`: the hash so far, to go on block by block.
+inline std::uint64_t state_checksum(const std::uint8_t* p, std::size_t n, std::uint64_t h = 14695981039346656037ull) {
   for (std::size_t i = 0; i < n; ++i) {
     h ^= p[i];
     h *= 1099511628211ull;

@@ -6,6 +6,7 @@
 // scenario keys they stand for. Anything else is an InputError of one line naming the file,
 // the dataset and what was expected.
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -53,6 +54,7 @@ struct StoredRun {
   std::vector<double> mass;  ///< /bodies/mass: the scene rebuilt must have the same bodies
   std::optional<StoredCheckpoint> checkpoint;
   int damaged_slots = 0;     ///< checkpoint slots with a wrong checksum (cut short by a kill)
+  std::map<std::string, std::string> inputs;  ///< /inputs: scenario key -> InputFile::text()
 };
 
 /// Reads a run's file, complete or not (RESULT.h5.partial); InputError as read_body_frame's.

@@ -126,6 +126,16 @@ struct WaveSpec {
   double direction = 0.0;   ///< rad, direction the waves travel to, counter-clockwise from +x
 };
 
+/// A file a scenario reads, as it was when read.
+struct InputFile {
+  std::string key;           ///< the scenario key naming it ("environment.current_file.file")
+  std::string path;          ///< as opened (a relative path joined to the scenario's folder)
+  std::uint64_t bytes = 0;
+  std::uint64_t digest = 0;  ///< FNV-1a, 64 bits, of its bytes (engine/state_io.hpp)
+  /// "fnv1a64 0123456789abcdef, 1234 bytes, PATH": the output's record of it.
+  std::string text() const;
+};
+
 /// [environment]: the water, the air and the earth the bodies move in.
 struct EnvironmentSpec {
   Vec2 current;                             ///< m/s, uniform (used when there is no profile)
@@ -207,6 +217,9 @@ struct Scene {
   EnvironmentSpec environment;
   TowSpec tow;
   std::vector<Provenance> provenance;
+  /// The files the scenario reads (forcing files, a field, a chart), each with its digest: the
+  /// output records them, and `floedem run --resume` refuses a file that has changed.
+  std::vector<InputFile> input_files;
 
   /// [engine.NAME] tables, kept as written: each engine reads and checks its own.
   std::map<std::string, toml::table> engine_settings;
