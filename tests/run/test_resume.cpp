@@ -254,7 +254,7 @@ TEST_CASE("resume: a run on the pressure-area force model killed and continued i
   fs::remove_all(f.dir);
 }
 
-TEST_CASE("resume: a forcing file changed since the run read it is refused; unchanged, continued", "[resume]") {
+TEST_CASE("resume: a forcing file changed since the run read it is refused, an unchanged one continued", "[resume]") {
   std::string text = kScenario;
   const std::string wind = "wind = [6.0, -2.0]\n";
   REQUIRE(text.find(wind) != std::string::npos);
