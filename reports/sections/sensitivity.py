@@ -125,8 +125,10 @@ def write(ctx):
         order = sorted(PARAMS, key=lambda p: abs(results[p[0]][q][0]))   # the largest at the top
         eff = [results[p[0]][q][0] * scale for p in order]
         err = [results[p[0]][q][1] * scale for p in order]
-        ax.barh(range(len(order)), eff, xerr=None if ctx.quick else err, color=["C3" if e > 0 else "C0" for e in eff],
-                capsize=3)
+        # A quantity of one run each (the collision: no field, so deterministic) has no interval.
+        has_err = not ctx.quick and not all(math.isnan(e) for e in err)
+        ax.barh(range(len(order)), eff, xerr=np.nan_to_num(err) if has_err else None,
+                color=["C3" if e > 0 else "C0" for e in eff], capsize=3)
         ax.set_yticks(range(len(order)))
         ax.set_yticklabels([f"{p[0]} {p[3]:g} -> {p[4]:g}" for p in order], fontsize=8)
         ax.axvline(0.0, color="k", lw=0.6)
@@ -156,13 +158,20 @@ def write(ctx):
             cells.append(f"{d * scale:+.3g}" + ("" if math.isnan(h) else f" +- {h * scale:.2g}"))
         md.append(f"| {p[0]} | {p[3]:g} -> {p[4]:g} | {p[5]} | " + " | ".join(cells) + " |")
     md.append("")
-    # Reading the ranks: which parameters an interval excludes zero for, per quantity.
+    # Reading the ranks: which parameters an interval excludes zero for, per quantity; for the
+    # deterministic collision (one run a point, no interval), those that move it by more than
+    # 1 % of its value at the defaults.
+    def matters(q, d, h):
+        if math.isnan(h):
+            return abs(d) > 0.01 * abs(np.mean(base[q]))
+        return abs(d) > h > 0.0 or (h == 0.0 and d != 0.0)
+
     if not ctx.quick:
         for q, (label, _) in enumerate(quantities):
             matter = [p[0] for p in sorted(PARAMS, key=lambda p: -abs(results[p[0]][q][0]))
-                      if abs(results[p[0]][q][0]) > results[p[0]][q][1] > 0.0 or
-                      (results[p[0]][q][1] == 0.0 and results[p[0]][q][0] != 0.0)]
-            md.append(f"- {label}: " + (", ".join(matter) if matter else "none beyond its interval") + ".")
+                      if matters(q, *results[p[0]][q])]
+            rule = "more than 1 % of its value" if math.isnan(results[PARAMS[0][0]][q][1]) else "beyond its interval"
+            md.append(f"- {label}: " + (", ".join(matter) if matter else "none") + f" ({rule}).")
         md.append("")
     fails = []
     # C_tau sets the reported duration and peak of a collision only: it must move no body.
