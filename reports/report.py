@@ -143,13 +143,16 @@ def main():
         body += md
         fails += f
     total = time.monotonic() - start
-    flags = (" --quick" if a.quick else "") + (f" --only {','.join(only)}" if only else "")
+    kept = sum(1 for r in ctx.all_runs if r.kept)
+    # A resumed report's run time is this launch's: the runs kept were made by an earlier one.
+    resumed = f" ({kept} of the runs kept from an interrupted launch into the same directory)" if kept else ""
+    flags = (" --quick" if a.quick else "") + (" --resume" if a.resume else "") + (f" --only {','.join(only)}" if only else "")
     head = [f"# floedem cross-engine report{' (--quick)' if a.quick else ''}"
             f"{' (sections: ' + ', '.join(only) + ')' if only else ''}", "",
             f"Written {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC by `floedem report"
             f"{flags}` ({version}, source commit {commit}) on {platform.node()} "
             f"({os.cpu_count()} cores, {a.jobs} runs at a time): {len(ctx.all_runs)} runs in {run_seconds:.0f} s, "
-            f"{total:.0f} s in all. Every table and figure below comes from the HDF5 files of those runs, in "
+            f"{total:.0f} s in all{resumed}. Every table and figure below comes from the HDF5 files of those runs, in "
             "`runs/` (each table names its files); none is typed or kept from an earlier report.", ""]
     if missing:
         head += [f"This build has no {', '.join(missing)} engine (configured off, or its library not found): the "

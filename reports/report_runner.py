@@ -26,6 +26,7 @@ class Run:
     threads: int = 0            # FLOEDEM_THREADS; 0: 1 for a timing run, else the cores / jobs
     bench_stages: bool = False  # a timing run that also times each stage (`floedem bench --stages`)
     stamp: str = ""             # filled in by run_all: the digest of the program and inputs
+    kept: bool = False          # filled in by run_all: made by an earlier launch (--resume)
 
     @property
     def timed(self):
@@ -105,7 +106,8 @@ def run_all(runs, floedem, runs_dir, jobs, label="report", resume=False):
     for r in runs:
         r.out = os.path.join(runs_dir, r.tag + (".csv" if r.timed else ".h5"))
         r.stamp = stamps.of(r)
-        if resume and _finished(runs_dir, r, floedem):
+        r.kept = resume and _finished(runs_dir, r, floedem)
+        if r.kept:
             kept += 1
             continue
         for stale in (r.out, r.out + ".partial", os.path.join(runs_dir, ".floedem", "done", r.tag + ".json"),

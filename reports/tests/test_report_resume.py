@@ -59,6 +59,7 @@ def test_a_resumed_report_keeps_finished_runs_and_makes_the_rest(setup, capsys):
     runs = make_runs(scene)
     assert run_all(runs, FLOEDEM, str(runs_dir), 1, "t", resume=True) == []
     assert "1 of 2 runs kept" in capsys.readouterr().out
+    assert [r.kept for r in runs] == [True, False]   # what the report's head counts
     after = stamps(runs)
     assert after["one"] == before["one"]
     assert after["two"] != before["two"]
