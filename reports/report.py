@@ -145,7 +145,7 @@ def main():
     total = time.monotonic() - start
     kept = sum(1 for r in ctx.all_runs if r.kept)
     # A resumed report's run time is this launch's: the runs kept were made by an earlier one.
-    resumed = f" ({kept} of the runs kept from an interrupted launch into the same directory)" if kept else ""
+    resumed = f" ({kept} of the runs made by an earlier launch of the same command into the same directory)" if kept else ""
     flags = (" --quick" if a.quick else "") + (" --resume" if a.resume else "") + (f" --only {','.join(only)}" if only else "")
     head = [f"# floedem cross-engine report{' (--quick)' if a.quick else ''}"
             f"{' (sections: ' + ', '.join(only) + ')' if only else ''}", "",
