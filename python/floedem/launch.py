@@ -141,7 +141,9 @@ def run_one(launch_json, job_id, threads):
     ok = p.returncode == 0
     target = os.path.join(done, job_id + (".json" if ok or job["may_fail"] else ".failed.json"))
     write_atomic(target, json.dumps(record))
-    count = len([n for n in os.listdir(done) if n.endswith(".json") and not n.endswith(".failed.json")])
+    # This launch's finished jobs: a folder reused with another plan keeps other jobs' records.
+    ids = {j["id"] for j in spec["jobs"]}
+    count = len([n for n in os.listdir(done) if n.endswith(".json") and n[:-len(".json")] in ids])
     status = "ok" if ok else ("failed" if job["may_fail"] else "FAILED")
     print(f"[{spec['label']} {count:4d}/{len(spec['jobs'])}] {seconds:7.1f} s  {status:6s} {job_id}", flush=True)
     if not ok and not job["may_fail"]:
