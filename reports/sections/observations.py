@@ -789,7 +789,7 @@ def rotation_under_tide(ctx, n_seeds):
         m, half, sd = interval(mean)
         v, how, settled = ensemble_verdict(mean, OBS["omega_mean"], floor=0.0)
         verdict = v if passes(v) else f"outside: {how}"
-        if settled < 0.9:
+        if settled < SETTLED:
             verdict += f" (*unsettled*: {settled:.0%} of resamples agree)"
         rows.append((major, m, half, sd, verdict, max(x["omega_max_late"] for x in d),
                      float(np.mean([x["berg"][0] for x in d]))))
