@@ -145,8 +145,10 @@ def main():
     total = time.monotonic() - start
     kept = sum(1 for r in ctx.all_runs if r.kept)
     # A resumed report's run time is this launch's: the runs kept were made by an earlier one.
-    resumed = f" ({kept} of the runs made by an earlier launch of the same command into the same directory)" if kept else ""
-    flags = (" --quick" if a.quick else "") + (" --resume" if a.resume else "") + (f" --only {','.join(only)}" if only else "")
+    resumed = (f" ({kept} of the runs made by an earlier launch of the same command into the same directory)"
+               if kept else "")
+    flags = ((" --quick" if a.quick else "") + (" --resume" if a.resume else "") +
+             (f" --only {','.join(only)}" if only else ""))
     head = [f"# floedem cross-engine report{' (--quick)' if a.quick else ''}"
             f"{' (sections: ' + ', '.join(only) + ')' if only else ''}", "",
             f"Written {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC by `floedem report"

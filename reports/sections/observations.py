@@ -273,9 +273,13 @@ def plan(ctx):
     for major in [0.0] + TIDE_MAJORS[ctx.quick]:
         scene = drift if major == 0.0 else tide_scene(ctx, drift, major)
         side, duration = TIDE_SCALE[ctx.quick]
+        # The quick drift's --set list with this scale's square, in the same order.
         scale = {"field.width": side, "field.height": side, "field.origin": f"[{-side / 2!r}, {-side / 2!r}]"}
-        sets = [f"{x.split('=')[0]}={scale[x.split('=')[0]]!s}" if x.split("=")[0] in scale else x
-                for x in config(True)["drift"] if not x.startswith("run.duration")]
+        sets = []
+        for x in config(True)["drift"]:
+            key = x.split("=")[0]
+            if key != "run.duration":
+                sets.append(f"{key}={scale[key]}" if key in scale else x)
         sets.append(f"run.duration={duration!r}")
         for k in range(SEEDS[ctx.quick]):
             runs.append(Run(seeded(f"obs_rotation_m2_{major:g}", k), scene, "native", sets + seed_set(drift, k),
