@@ -60,11 +60,10 @@ ResumeResult resume_run(const std::string& path, const std::vector<std::string>&
   // would continue another run under this one's name. (A file written before floedem recorded
   // its inputs has no /inputs: nothing to hold it to.)
   for (const InputFile& f : scene.input_files) {
+    if (run.inputs.empty()) break;
     const auto it = run.inputs.find(f.key);
-    if (it == run.inputs.end()) {
-      if (run.inputs.empty()) break;
+    if (it == run.inputs.end())
       throw InputError(stored + ": " + f.key + " (" + f.path + ") was not read by the run; the scenario has changed");
-    }
     if (it->second != f.text())
       throw InputError(input_message(f.path, 0, f.key,
                                      "has changed since the run read it (the run recorded " + it->second + "; now " +

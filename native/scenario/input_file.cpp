@@ -20,7 +20,7 @@ std::string InputFile::text() const {
 }
 
 InputFile read_input_file(const std::string& key, const std::string& path) {
-  InputFile f{key, path, 0, 14695981039346656037ull};
+  InputFile f{key, path, 0, kChecksumStart};
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(input_message(path, 0, key, std::string("cannot read it: ") + std::strerror(errno)));
   std::vector<char> block(1 << 20);

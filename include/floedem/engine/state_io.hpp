@@ -108,7 +108,9 @@ class StateReader {
 
 /// FNV-1a, 64 bits: tells a checkpoint written whole from one cut short by a kill, and an input
 /// file from one changed since a run read it. `h`: the hash so far, to go on block by block.
-inline std::uint64_t state_checksum(const std::uint8_t* p, std::size_t n, std::uint64_t h = 14695981039346656037ull) {
+/// FNV-1a's offset basis: the hash of no bytes, where a hash block by block starts.
+inline constexpr std::uint64_t kChecksumStart = 14695981039346656037ull;
+inline std::uint64_t state_checksum(const std::uint8_t* p, std::size_t n, std::uint64_t h = kChecksumStart) {
   for (std::size_t i = 0; i < n; ++i) {
     h ^= p[i];
     h *= 1099511628211ull;
