@@ -21,7 +21,7 @@ import time
 HERE = os.path.dirname(os.path.realpath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from report_runner import run_all  # noqa: E402  (it puts the floedem package on the path)
+from report_runner import cost_lines, run_all  # noqa: E402  (it puts the floedem package on the path)
 from floedem.launch import write_atomic  # noqa: E402
 from sections import SECTIONS  # noqa: E402
 from sections.speed import load_stage_labels  # noqa: E402
@@ -114,14 +114,15 @@ def main():
     if os.path.exists(report):
         os.remove(report)
 
-    seen = {}
-    for section in sections:
+    seen, owner = {}, {}   # tag -> its run, and the section that asked for it first
+    for section, name in ((s, n) for s, n in zip(SECTIONS, names) if s in sections):
         for r in section.plan(ctx):
             if r.tag in seen:
                 if seen[r.tag].command("x") != r.command("x"):
                     raise SystemExit(f"report: two sections ask for run {r.tag} differently")
                 continue
             seen[r.tag] = r
+            owner[r.tag] = name
             ctx.all_runs.append(r)
     print(f"report: {len(ctx.all_runs)} runs on {', '.join(engines)}, {a.jobs} at a time, into {ctx.runs_dir}",
           flush=True)
@@ -142,6 +143,7 @@ def main():
         md, f = section.write(ctx)
         body += md
         fails += f
+    body += cost_lines(ctx.all_runs, owner, ctx.launch_seconds, a.jobs)
     total = time.monotonic() - start
     kept = sum(1 for r in ctx.all_runs if r.kept)
     # A resumed report's run time is this launch's: the runs kept were made by an earlier one.

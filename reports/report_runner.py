@@ -139,3 +139,37 @@ def run_all(runs, floedem, runs_dir, jobs, label="report", resume=False):
         if r.error:
             failed.append(r)
     return failed
+
+
+def cost_lines(runs, owner, launch_seconds, jobs):
+    """The report's own cost, measured: per section (owner: run tag -> the section that planned it
+    first), its runs, their run time (wall seconds of each process: on one thread each, its CPU
+    time), the share of the report's run time, and its longest run; the timing runs, made alone
+    on an otherwise idle machine, apart. A resumed report counts the runs it kept at the time
+    their launch measured. Markdown lines, for the report's last section."""
+    rows = {}
+    for r in runs:
+        row = rows.setdefault(owner[r.tag], dict(n=0, seconds=0.0, timed=0.0, longest=(0.0, "")))
+        row["n"] += 1
+        row["seconds"] += r.seconds
+        if r.timed:
+            row["timed"] += r.seconds
+        if r.seconds > row["longest"][0]:
+            row["longest"] = (r.seconds, r.tag)
+    total = sum(x["seconds"] for x in rows.values())
+    timed = sum(x["timed"] for x in rows.values())
+    md = ["## What this report cost", "",
+          f"{len(runs)} runs, {total:.0f} s of run time (each run's wall time, on one thread unless the section "
+          f"says otherwise), {timed:.0f} s of it timing runs made alone; the launch took {launch_seconds:.0f} s with "
+          f"{jobs} runs at a time. By section, the most costly first:", "",
+          "| section | runs | run time (s) | share | of it timing runs, alone (s) | longest run (s) |",
+          "|---|---|---|---|---|---|"]
+    def sec(t):
+        return f"{t:.0f}" if t >= 10.0 else f"{t:.1f}"
+
+    for name, x in sorted(rows.items(), key=lambda kv: -kv[1]["seconds"]):
+        share = x["seconds"] / total if total > 0 else 0.0
+        md.append(f"| {name} | {x['n']} | {sec(x['seconds'])} | {share:.1%} | {sec(x['timed'])} | "
+                  f"{sec(x['longest'][0])} (`{x['longest'][1]}`) |")
+    md.append("")
+    return md
