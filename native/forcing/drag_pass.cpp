@@ -62,7 +62,7 @@ FLOEDEM_LANES void finish_group(const DragPass::Shape& shape, const DragPass::Gr
 }
 
 /// One group of four floes, every term of the run (drag_pass.hpp): the operations of
-/// form_quad and skin_quad (drag.cpp), each point formed from the corners as edge_points and
+/// form_quad and skin_quad (drag_lanes.cpp), each point formed from the corners as edge_points and
 /// area_points form it, turned into the world once for every term.
 // kTerms > 0: the run's shape fixed at compile time (kForm: bit t set where term t is form
 // drag), so that the loops over the terms unroll and their values stay in registers; 0: read
