@@ -19,7 +19,16 @@ import sys
 
 import numpy as np
 
-import floedem
+try:
+    import floedem
+except ModuleNotFoundError:
+    # Run from a checkout rather than an installed floedem: the package beside it.
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..", "python"))
+    try:
+        import floedem
+    except ModuleNotFoundError:
+        sys.exit("make_forcing.py: no Python package floedem: install floedem (cmake --install build) or set "
+                 "PYTHONPATH to a checkout's python/ folder")
 
 START = "2009-05-15T00:00:00Z"   # hindcast.toml's [run] start
 M2 = 44714.16                    # s, the M2 period (docs/forcing.md)
