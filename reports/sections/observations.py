@@ -93,8 +93,10 @@ CAUSES = {
                              "water drag along the relative velocity; the observed turning also carries the ocean "
                              "boundary layer's own turning, which the model does not have. Within a degree of the "
                              "range's end.",
-    "drift_floe_deflection": "the deflection comes from Coriolis on the floes' mass against a water drag along the "
-                             "relative velocity, with no turning of the water stress in the ocean's boundary layer. "
+    "drift_floe_deflection": "the deflection is the turn Coriolis gives the floes' mass against their water drag, "
+                             "so it grows with their thickness (the scene's 1 m; the tracked ice was 0.5 to 1.5 m) "
+                             "and falls with their drag. The turning of the water stress in the ocean's boundary "
+                             "layer, which the model leaves out, would turn the drift further right, not back. "
                              "Within about a degree of the range's end.",
     "drift_floe_factor": "the floes' wind factor is set by air over water drag on their skins and edges; their "
                          "edges' form drag, which floedem applies to every floe in full (no sheltering by neighbours), "
