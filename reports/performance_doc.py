@@ -115,7 +115,7 @@ paid on the machines named above (one thread unless said; profiles by `perf reco
 
 - Floes numbered along a Hilbert curve (`native/field/field_generator.cpp`): the 16k speed
   benchmark 8 % faster, the 10^5 field 16 % (Box2D 7 % at 16k), against the sites' random order.
-- Prefetch ahead in the drag quadrature (`native/forcing/drag.cpp`): the slots' first loads
+- Prefetch ahead in the drag quadrature (`native/forcing/drag_lanes.cpp`): the slots' first loads
   were over a third of the loop's samples at 16k floes; the rate bound's moments read in group
   order (`drag.hpp`): their reads by entry were two thirds of its samples.
 - The pair cache's unbranched overlap test (`native/collision/pair_cache.cpp`): the towing
