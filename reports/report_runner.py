@@ -93,13 +93,21 @@ def _finished(runs_dir, r, floedem):
     return ok and rec.get("argv") == r.command(floedem) and rec.get("stamp") == r.stamp
 
 
+def continuable(r):
+    """A run `floedem run --resume` continues from its checkpoint: native's (the reference
+    engines' would be made again from the start, which the launcher does anyway)."""
+    return not r.timed and r.engine == "native"
+
+
 def run_all(runs, floedem, runs_dir, jobs, label="report", resume=False):
     """Runs every Run into runs_dir through floedem.launch (Snakemake, the project's one way of
     launching runs): `jobs` at a time, the longest first, then the timing runs one at a time,
     alone. Prints one line per finished run. Returns the runs that failed.
 
     resume: keep a run already in runs_dir whose record says it finished with the same command
-    and the same stamp (Stamps); every other output is removed and made again."""
+    and the same stamp (Stamps); continue a native run stopped or killed under them from its
+    checkpoint (floedem.launch: its RESULT.h5.partial); every other output is removed and made
+    again."""
     os.makedirs(runs_dir, exist_ok=True)
     stamps = Stamps(floedem)
     kept = 0
@@ -110,9 +118,12 @@ def run_all(runs, floedem, runs_dir, jobs, label="report", resume=False):
         if r.kept:
             kept += 1
             continue
+        # A native run's .partial stays: the launcher continues it if a try of this command and
+        # stamp left it, and the run overwrites it otherwise.
+        keep = r.out + ".partial" if continuable(r) else None
         for stale in (r.out, r.out + ".partial", os.path.join(runs_dir, ".floedem", "done", r.tag + ".json"),
                       os.path.join(runs_dir, ".floedem", "done", r.tag + ".failed.json")):
-            if os.path.exists(stale):
+            if stale != keep and os.path.exists(stale):
                 os.remove(stale)
     if resume:
         print(f"{label}: resuming: {kept} of {len(runs)} runs kept from before (same program, command and inputs)",
@@ -123,7 +134,10 @@ def run_all(runs, floedem, runs_dir, jobs, label="report", resume=False):
     share = max(1, cores // max(1, jobs))
     untimed = sorted([r for r in runs if not r.timed], key=lambda r: -r.cost)
     todo = [Job(r.tag, r.command(floedem), threads=r.threads or share, priority=len(untimed) - k + 1000,
-                may_fail=True, stamp=r.stamp) for k, r in enumerate(untimed)]
+                may_fail=True, stamp=r.stamp, **(dict(partial=r.out + ".partial",
+                                                      resume_argv=[floedem, "run", "--resume", r.out + ".partial", "-q"])
+                                                 if continuable(r) else {}))
+            for k, r in enumerate(untimed)]
     ids = [j.id for j in todo]
     todo += [Job(r.tag, r.command(floedem), threads=r.threads or 1, alone=True, after=ids, may_fail=True,
                  stamp=r.stamp) for r in runs if r.timed]

@@ -1,8 +1,11 @@
 // floedem command line. Exit codes: 0 done; 1 unexpected error; 2 bad input (scenario,
 // options, engine settings); 3 output could not be written; 4 the solver failed (report: a run
-// failed); 5 report: the engines disagree beyond the documented tolerances.
+// failed); 5 report: the engines disagree beyond the documented tolerances; 128 + N a run
+// stopped by signal N (143 SIGTERM, 130 SIGINT) after writing a checkpoint of its last step.
 #include <CLI/CLI.hpp>
 
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <algorithm>
 #include <cstdlib>
@@ -24,6 +27,28 @@
 
 namespace {
 
+// A run stops at the end of its step on SIGTERM (the notice a batch system gives before it
+// kills a job: Slurm's at the time limit or on preemption) or SIGINT (Ctrl-C) and writes a
+// checkpoint of that step first (RunOptions::stop). The handler only sets the flag; it resets
+// itself, so a second signal kills at once.
+std::atomic<bool> stop_requested{false};
+volatile std::sig_atomic_t stop_signal = 0;
+static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
+
+extern "C" void request_stop(int signal) {
+  stop_signal = signal;
+  stop_requested.store(true, std::memory_order_relaxed);
+}
+
+void stop_on_signals() {
+  struct sigaction action {};
+  action.sa_handler = request_stop;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGINT, &action, nullptr);
+}
+
 std::string default_output(const std::string& scenario, const std::string& engine) {
   return std::filesystem::path(scenario).stem().string() + "." + engine + ".h5";
 }
@@ -37,6 +62,8 @@ int run_command(const std::string& scenario_path, const std::string& engine, std
   options.engine = engine;
   options.output = output;
   options.progress = !quiet;
+  options.stop = &stop_requested;
+  stop_on_signals();
   const RunSummary summary = run_scene(scene, options);
   if (!quiet) std::cout << format_summary(scene, summary, output);
   return 0;
@@ -44,7 +71,8 @@ int run_command(const std::string& scenario_path, const std::string& engine, std
 
 int resume_command(const std::string& path, const std::vector<std::string>& overrides, bool quiet) {
   using namespace floedem;
-  const ResumeResult r = resume_run(path, overrides, !quiet);
+  stop_on_signals();
+  const ResumeResult r = resume_run(path, overrides, !quiet, &stop_requested);
   if (!r.ran) {
     if (!quiet) std::cout << r.message << "\n";
     return 0;
@@ -322,6 +350,9 @@ int failure_status(const std::exception_ptr& error) {
   } catch (const floedem::SolverFailure& e) {
     std::cerr << "floedem: solver failure: " << e.what() << "\n";
     return 4;
+  } catch (const floedem::RunStopped& e) {
+    std::cerr << "floedem: " << (stop_signal == SIGINT ? "SIGINT" : "SIGTERM") << ": " << e.what() << "\n";
+    return 128 + (stop_signal != 0 ? static_cast<int>(stop_signal) : SIGTERM);
   } catch (const std::exception& e) {
     std::cerr << "floedem: unexpected error: " << e.what() << "\n";
     return 1;

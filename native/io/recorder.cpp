@@ -530,11 +530,37 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& r
 }
 
 void Recorder::write_checkpoint(std::int64_t index, std::int64_t step, const std::vector<std::uint8_t>& state) {
+  write_slot(kCheckpointSlots[index % 2], step, state);
+  // A regular checkpoint supersedes a stopped run's: dropped only now that this one is whole.
+  drop_stop_checkpoint();
+}
+
+void Recorder::write_stop_checkpoint(std::int64_t step, const std::vector<std::uint8_t>& state) {
+  write_slot(kCheckpointSlots[2], step, state);
+}
+
+void Recorder::drop_stop_checkpoint() {
+  Impl& d = *impl_;
+  try {
+    if (!d.file.nameExists("/checkpoint") || !d.file.nameExists(kCheckpointSlots[2])) return;
+    if (H5Ldelete(d.file.getId(), kCheckpointSlots[2], H5P_DEFAULT) < 0)
+      throw H5::FileIException("H5Ldelete", kCheckpointSlots[2]);
+    // A run stopped before its first regular checkpoint: the group goes too, as a run never
+    // stopped has none.
+    if (d.file.openGroup("/checkpoint").getNumObjs() == 0 && H5Ldelete(d.file.getId(), "/checkpoint", H5P_DEFAULT) < 0)
+      throw H5::FileIException("H5Ldelete", "/checkpoint");
+    d.file.flush(H5F_SCOPE_GLOBAL);
+  } catch (const H5::Exception& e) {
+    d.write_failed = true;
+    throw OutputError(partial_path_ + ": could not drop the stopped run's checkpoint (" + e.getDetailMsg() + ")");
+  }
+}
+
+void Recorder::write_slot(const char* name, std::int64_t step, const std::vector<std::uint8_t>& state) {
   Impl& d = *impl_;
   try {
     d.write_buffers();
     H5::Group group = d.file.nameExists("/checkpoint") ? d.file.openGroup("/checkpoint") : d.file.createGroup("/checkpoint");
-    const char* name = kCheckpointSlots[index % 2];
     const hsize_t size = state.size();
     if (!d.file.nameExists(name)) {
       const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = 1 << 16;
@@ -755,6 +781,7 @@ void Recorder::write_polygons(const std::string& group, const std::string& name,
 
 void Recorder::finish(const std::vector<std::pair<std::string, double>>& summary) {
   Impl& d = *impl_;
+  drop_stop_checkpoint();  // a run stopped and continued past its last regular checkpoint holds one
   try {
     H5::Group root = d.file.openGroup("/");
     for (const auto& [k, v] : summary) write_attribute(root, "summary_" + k, v);

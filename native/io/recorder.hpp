@@ -31,8 +31,12 @@ struct RecordedRows {
   std::int64_t frames = 0, contacts = 0, collisions = 0, tow = 0, loads = 0;
 };
 
-/// The two checkpoint datasets, written in turn.
-inline constexpr const char* kCheckpointSlots[2] = {"/checkpoint/slot_a", "/checkpoint/slot_b"};
+/// The checkpoint datasets: the two regular ones, written in turn, and the one a run stopped
+/// on request (SIGTERM) writes at the step it stops after. That third one is dropped once a
+/// regular checkpoint follows it and when the run ends, so a run stopped and continued ends
+/// with the datasets of a run never stopped.
+inline constexpr const char* kCheckpointSlots[3] = {"/checkpoint/slot_a", "/checkpoint/slot_b",
+                                                    "/checkpoint/stopped"};
 
 /// The checksum of a checkpoint slot: its bytes and its step (a slot whose step attribute
 /// was written without its bytes, or the reverse, fails it).
@@ -71,6 +75,9 @@ class Recorder {
   /// and checksum, and flushes: the file then holds a whole checkpoint even if the process
   /// is killed while the next one is written (the other slot).
   void write_checkpoint(std::int64_t index, std::int64_t step, const std::vector<std::uint8_t>& state);
+  /// Writes every buffered row, then `state` into the stopped run's slot (kCheckpointSlots[2]),
+  /// and flushes; the regular slots are left as they are.
+  void write_stop_checkpoint(std::int64_t step, const std::vector<std::uint8_t>& state);
   /// Rows so far, buffered included.
   RecordedRows rows() const;
   /// Frames per chunk of the frame tables (a checkpoint follows each full chunk).
@@ -89,6 +96,9 @@ class Recorder {
   /// Returns the file's format_version (a format 1 run is continued in format 1).
   std::int64_t check_tables(const std::string& file, const Scene& scene, const RecordedRows& rows) const;
   void write_run_attributes(const Scene& scene, const RunInfo& run);
+  void write_slot(const char* name, std::int64_t step, const std::vector<std::uint8_t>& state);
+  /// Removes the stopped run's checkpoint, if there is one.
+  void drop_stop_checkpoint();
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::string path_;

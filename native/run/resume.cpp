@@ -25,7 +25,8 @@ std::string override_key(const std::string& o) { return trim(o.substr(0, o.find(
 
 }  // namespace
 
-ResumeResult resume_run(const std::string& path, const std::vector<std::string>& overrides, bool progress) {
+ResumeResult resume_run(const std::string& path, const std::vector<std::string>& overrides, bool progress,
+                        const std::atomic<bool>* stop) {
   namespace fs = std::filesystem;
   // The run's final name, and the file that holds it now: a run under way or killed is
   // RESULT.h5.partial (the newer one when both are there), a finished run RESULT.h5.
@@ -86,6 +87,7 @@ ResumeResult resume_run(const std::string& path, const std::vector<std::string>&
   options.output = final_path;
   result.summary_output = final_path;
   options.progress = progress;
+  options.stop = stop;
   if (run.checkpoint) {
     options.resume_state = &run.checkpoint->state;
     result.message =

@@ -71,11 +71,12 @@ class Progress {
   clock::time_point last_ = clock::now() - std::chrono::hours(1);
 };
 
-/// A test hook: FLOEDEM_TEST_KILL_AT_STEP=k makes the process kill itself (SIGKILL: no
-/// destructor runs, as when a job is killed) right after step k, so that a test of --resume
-/// can interrupt a run at a chosen place. 0 when unset.
-std::int64_t kill_at_step() {
-  const char* v = std::getenv("FLOEDEM_TEST_KILL_AT_STEP");
+/// Test hooks: FLOEDEM_TEST_KILL_AT_STEP=k makes the process kill itself (SIGKILL: no
+/// destructor runs, as when a job is killed) right after step k, FLOEDEM_TEST_TERM_AT_STEP=k
+/// send itself SIGTERM (a batch system's notice), so that a test of --resume can interrupt a
+/// run at a chosen place. 0 when unset.
+std::int64_t test_signal_step(const char* name) {
+  const char* v = std::getenv(name);
   return v ? std::strtoll(v, nullptr, 10) : 0;
 }
 
@@ -291,6 +292,29 @@ class SceneRun {
   // state after step k and the rows written by then. Engines that cannot save their state
   // get none (--resume then runs them again from the start).
   void checkpoint(std::int64_t k) {
+    if (!checkpoint_state(k, tally_.checkpoints + 1)) return;
+    ++tally_.checkpoints;
+    recorder_->write_checkpoint(tally_.checkpoints - 1, k, checkpoint_bytes_.bytes());
+  }
+
+ public:
+  /// Stopped on request after step k: its state into the stopped run's slot. The regular
+  /// checkpoints' count is saved as it is, so a run continued from here writes the regular
+  /// checkpoints, in the same slots, that a run never stopped writes. False where the engine
+  /// cannot save its state.
+  bool checkpoint_on_stop(std::int64_t k) {
+    if (!checkpoint_state(k, tally_.checkpoints)) return false;
+    recorder_->write_stop_checkpoint(k, checkpoint_bytes_.bytes());
+    return true;
+  }
+  const std::string& partial_path() const { return recorder_->partial_path(); }
+
+ private:
+  /// The state after step k into checkpoint_bytes_, with `count` regular checkpoints written
+  /// (what the continued run's tally starts from). False, and no more checkpoints, where the
+  /// engine cannot save its state.
+  bool checkpoint_state(std::int64_t k, std::int64_t count) {
+    if (!checkpoints_) return false;
     StateWriter& out = checkpoint_bytes_;
     out.clear();
     out.tag("floedem checkpoint");
@@ -299,14 +323,15 @@ class SceneRun {
     save_rows(out, recorder_->rows());
     if (!stepper_.save(out)) {
       checkpoints_ = false;
-      return;
+      return false;
     }
-    ++tally_.checkpoints;
-    tally_.save(out);
+    Tally saved = tally_;
+    saved.checkpoints = count;
+    saved.save(out);
     collisions_.save(out);
     loads_.save(out);
     energy_.save(out);
-    recorder_->write_checkpoint(tally_.checkpoints - 1, k, out.bytes());
+    return true;
   }
 
   const Scene& scene_;
@@ -336,11 +361,24 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const std::int64_t first = run.open();
   const std::int64_t steps = scene.run.steps();
   Progress progress(options.progress, first - 1);
-  const std::int64_t kill_at = kill_at_step();
+  const std::int64_t kill_at = test_signal_step("FLOEDEM_TEST_KILL_AT_STEP");
+  const std::int64_t term_at = test_signal_step("FLOEDEM_TEST_TERM_AT_STEP");
   for (std::int64_t k = first; k <= steps; ++k) {
     run.step(k);
     progress.update(k, steps);
     if (k == kill_at) std::raise(SIGKILL);
+    if (k == term_at) std::raise(SIGTERM);
+    if (options.stop && k < steps && options.stop->load(std::memory_order_relaxed)) {
+      progress.done();
+      const bool saved = run.checkpoint_on_stop(k);
+      const std::string at = "step " + std::to_string(k) + " (t = " + setting_text(static_cast<double>(k) * scene.run.dt) + " s)";
+      throw RunStopped(saved ? "stopped after " + at + "; its checkpoint is in " + run.partial_path() +
+                                   ": floedem run --resume " + run.partial_path() + " continues the run from there"
+                             : "stopped after " + at + "; the " + options.engine + " engine cannot save its state: " +
+                                   run.partial_path() + " holds the rows so far, and floedem run --resume runs it "
+                                   "again from t = 0",
+                       k, saved);
+    }
   }
   progress.done();
   return run.finish(start);

@@ -288,14 +288,4 @@ void ContactPipeline::restore_contacts(StateReader& in, const StepContext& ctx) 
   forget_narrow();  // a restored run computes its first narrow phase afresh, as the saved one did
 }
 
-void ContactPipeline::save_counts(StateWriter& out) const {
-  out.value(narrow_pairs_);
-  out.value(narrow_reused_);
-}
-
-void ContactPipeline::restore_counts(StateReader& in) {
-  in.value(narrow_pairs_);
-  in.value(narrow_reused_);
-}
-
 }  // namespace floedem

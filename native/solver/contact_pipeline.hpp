@@ -74,11 +74,10 @@ class ContactPipeline {
   std::int64_t narrow_pairs() const { return narrow_pairs_; }
   std::int64_t narrow_reused() const { return narrow_reused_; }
 
-  /// Checkpoint: the carried contacts, the pair cache and the narrow phase's counts.
+  /// Checkpoint: the carried contacts and the pair cache (the narrow phase's counts are this
+  /// process's: NativeEngine::add_work_counts).
   void save_contacts(StateWriter& out) const;
   void restore_contacts(StateReader& in, const StepContext& ctx);
-  void save_counts(StateWriter& out) const;
-  void restore_counts(StateReader& in);
 
  private:
   static constexpr std::size_t kPairGrain = 512;    // pairs per block (narrow phase, contact list)

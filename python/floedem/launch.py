@@ -4,9 +4,13 @@ profile. Each job is one rule of a Snakefile written for the list (its threads, 
 the longest first, and what must finish before it); each leaves a record of its exit status and
 wall time in WORKDIR/.floedem/done/ID.json, so that a job done is never run again, and a list
 stopped half way and launched again runs only what is missing. A job whose command fails is
-retried (twice) unless it may fail (its failure is then recorded, not retried)."""
+retried (twice) unless it may fail (its failure is then recorded, not retried). A job stopped
+by a signal (a cluster's SIGTERM: `floedem run` checkpoints its step first) leaves no record,
+and where it names how to continue its output, the next try continues it rather than starting
+over."""
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -25,6 +29,10 @@ class Job:
     stamp: str = ""               # what the job's result depends on beyond its command (a digest
                                   # of the program and its inputs): a record with another stamp
                                   # or command is not this job's, and the job runs again
+    partial: str = ""             # the output a stopped or killed try leaves (RESULT.h5.partial)
+    resume_argv: list = field(default_factory=list)  # the command that continues it (floedem run
+                                  # --resume); used when `partial` is there and was left by a try
+                                  # of this job's command and stamp (WORKDIR/.floedem/started/)
 
 
 def _rule(job, index):
@@ -126,18 +134,46 @@ def records(jobs, workdir):
     return out
 
 
+# Exit statuses of a command stopped by a signal: killed (negative), or `floedem run`'s own
+# 128 + N after it wrote the checkpoint of its last step.
+STOPPED = {128 + signal.SIGTERM, 128 + signal.SIGINT}
+
+
+def _started_here(started, job):
+    """Whether the job's last try was of this command and stamp (so its partial output is this
+    job's to continue)."""
+    try:
+        with open(started) as f:
+            rec = json.load(f)
+    except (OSError, ValueError):
+        return False
+    return rec.get("argv") == job["argv"] and rec.get("stamp", "") == job.get("stamp", "")
+
+
 def run_one(launch_json, job_id, threads):
-    """The workflow's rule: runs one job's command, records it, prints a progress line."""
+    """The workflow's rule: runs one job's command (or continues its stopped output), records
+    it, prints a progress line."""
     with open(launch_json) as f:
         spec = json.load(f)
     job = next(j for j in spec["jobs"] if j["id"] == job_id)
-    done = os.path.join(os.path.dirname(launch_json), "done")
+    meta = os.path.dirname(launch_json)
+    done = os.path.join(meta, "done")
+    started = os.path.join(meta, "started", job_id + ".json")
+    os.makedirs(os.path.dirname(started), exist_ok=True)
     env = dict(os.environ, FLOEDEM_THREADS=str(max(1, job["threads"] if job["alone"] else threads)))
+    partial, resume = job.get("partial", ""), job.get("resume_argv", [])
+    continued = bool(partial and resume and os.path.exists(partial) and _started_here(started, job))
+    write_atomic(started, json.dumps(dict(argv=job["argv"], stamp=job.get("stamp", ""))))
     t0 = time.monotonic()
-    p = subprocess.run(job["argv"], capture_output=True, text=True, env=env)
+    p = subprocess.run(resume if continued else job["argv"], capture_output=True, text=True, env=env)
     seconds = time.monotonic() - t0
+    if p.returncode < 0 or p.returncode in STOPPED:
+        # Stopped, not finished: no record, so the job is tried again (and continued, where it can).
+        print(f"[{spec['label']}] {seconds:7.1f} s  stopped {job_id}: {(p.stderr or p.stdout).strip()[-300:]}",
+              file=sys.stderr, flush=True)
+        return p.returncode if p.returncode > 0 else 1
     record = dict(returncode=p.returncode, seconds=seconds, error=(p.stderr or p.stdout).strip()[-2000:]
-                  if p.returncode else "", argv=job["argv"], stamp=job.get("stamp", ""))
+                  if p.returncode else "", argv=job["argv"], stamp=job.get("stamp", ""), continued=continued)
     ok = p.returncode == 0
     target = os.path.join(done, job_id + (".json" if ok or job["may_fail"] else ".failed.json"))
     write_atomic(target, json.dumps(record))

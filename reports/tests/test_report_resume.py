@@ -105,3 +105,49 @@ def test_launch_forgets_a_record_of_another_command_or_stamp(tmp_path):
     (done / "c.failed.json").write_text(json.dumps(dict(returncode=1, argv=["x", "3"], stamp="old")))
     assert sorted(forget_stale(jobs, str(tmp_path))) == ["b", "c"]
     assert sorted(os.listdir(done)) == ["a.json"]
+
+
+def same_file(a, b):
+    """Every dataset and attribute of two HDF5 files, the same to the bit."""
+    import h5py
+    import numpy as np
+    with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+        names = []
+        fa.visit(names.append)
+        other = []
+        fb.visit(other.append)
+        assert sorted(names) == sorted(other)
+        for obj in [""] + names:
+            x, y = (fa[obj] if obj else fa), (fb[obj] if obj else fb)
+            assert sorted(x.attrs) == sorted(y.attrs), obj
+            for k in x.attrs:
+                assert np.array_equal(np.asarray(x.attrs[k]), np.asarray(y.attrs[k])), (obj, k)
+            if isinstance(x, h5py.Dataset):
+                assert x.shape == y.shape and x[()].tobytes() == y[()].tobytes(), obj
+
+
+def test_a_run_stopped_by_sigterm_is_continued_from_its_checkpoint(setup, monkeypatch):
+    # SIGTERM after step 7 of 30 (a cluster's notice): floedem checkpoints that step and exits
+    # 143; the launcher records nothing, and its next try continues the run rather than
+    # starting over. The file is the uninterrupted run's.
+    scene, runs_dir = setup
+    whole = [Run("two", str(scene), sets=["run.duration=3.0"])]
+    assert run_all(whole, FLOEDEM, str(runs_dir / "whole"), 1, "t") == []
+    monkeypatch.setenv("FLOEDEM_TEST_TERM_AT_STEP", "7")
+    runs = [Run("two", str(scene), sets=["run.duration=3.0"])]
+    assert run_all(runs, FLOEDEM, str(runs_dir / "cut"), 1, "t") == []
+    with open(runs_dir / "cut" / ".floedem" / "done" / "two.json") as f:
+        assert json.load(f)["continued"] is True
+    same_file(whole[0].out, runs[0].out)
+    # Stopped, then the report resumed: the partial of this command is continued, too.
+    runs = [Run("two", str(scene), sets=["run.duration=3.0"])]
+    assert run_all(runs, FLOEDEM, str(runs_dir / "again"), 1, "t") == []
+    os.remove(runs[0].out)
+    os.remove(runs_dir / "again" / ".floedem" / "done" / "two.json")
+    shutil.copy(whole[0].out, runs[0].out + ".partial")   # as a run's file stands before its rename
+    monkeypatch.delenv("FLOEDEM_TEST_TERM_AT_STEP")
+    runs = [Run("two", str(scene), sets=["run.duration=3.0"])]
+    assert run_all(runs, FLOEDEM, str(runs_dir / "again"), 1, "t", resume=True) == []
+    with open(runs_dir / "again" / ".floedem" / "done" / "two.json") as f:
+        assert json.load(f)["continued"] is True
+    same_file(whole[0].out, runs[0].out)

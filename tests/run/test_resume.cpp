@@ -346,6 +346,91 @@ TEST_CASE("resume: a finished run lengthened with run.duration is the longer run
   fs::remove_all(f.dir);
 }
 
+TEST_CASE("resume: SIGTERM checkpoints the step the run stopped after, continued it is the uninterrupted file",
+          "[resume][signal]") {
+  const Files f = write_scenario("term");
+  REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+  CHECK_FALSE(whole.count("/checkpoint/stopped"));
+
+  // SIGTERM after step 777 of 1200 (a batch system's notice): the run ends that step, writes
+  // its checkpoint and exits 128 + 15, the file left as .partial.
+  const auto stopped = test::run_cli(run_args(f, "cut.h5"), "FLOEDEM_TEST_TERM_AT_STEP=777 ");
+  INFO(stopped.output);
+  CHECK(stopped.code == 143);
+  CHECK(stopped.output.find("SIGTERM: stopped after step 777 (t = 38.85 s)") != std::string::npos);
+  CHECK(stopped.output.find("floedem run --resume") != std::string::npos);
+  CHECK_FALSE(fs::exists(f.dir / "cut.h5"));
+  REQUIRE(fs::exists(f.dir / "cut.h5.partial"));
+  StoredRun stored = read_stored_run((f.dir / "cut.h5.partial").string());
+  CHECK(stored.status == "running");
+  REQUIRE(stored.checkpoint);
+  CHECK(stored.checkpoint->step == 777);
+
+  // Continued and stopped again, then continued to the end.
+  const auto again = test::run_cli("run --resume " + (f.dir / "cut.h5").string() + " -q", "FLOEDEM_TEST_TERM_AT_STEP=1001 ");
+  INFO(again.output);
+  CHECK(again.code == 143);
+  stored = read_stored_run((f.dir / "cut.h5.partial").string());
+  REQUIRE(stored.checkpoint);
+  CHECK(stored.checkpoint->step == 1001);
+  const auto resumed = test::run_cli("run --resume " + (f.dir / "cut.h5").string());
+  INFO(resumed.output);
+  REQUIRE(resumed.code == 0);
+  CHECK(resumed.output.find("continued from the checkpoint at t = 50.05 s") != std::string::npos);
+  check_same_contents(whole, f.dir / "cut.h5");
+
+  // A stop asked for at the last step changes nothing: the run ends whole.
+  const auto last = test::run_cli(run_args(f, "last.h5"), "FLOEDEM_TEST_TERM_AT_STEP=1200 ");
+  CHECK(last.code == 0);
+  check_same_contents(whole, f.dir / "last.h5");
+  fs::remove_all(f.dir);
+}
+
+TEST_CASE("resume: floes at rest (sleeping, manifolds carried over) stopped and killed, the same file",
+          "[resume][signal]") {
+  // The iceberg towed into a field at rest: the floes ahead of it sleep and their parts and
+  // manifolds are kept from step to step, caches that a continued run starts without. What
+  // they save is the process's (floedem bench's work counts), not the file's, so a run
+  // stopped or killed anywhere and continued still ends as the uninterrupted one.
+  std::string text = kScenario;
+  for (const std::string line : {"current = [0.2, 0.05]\n", "wind = [6.0, -2.0]\n", "velocity = [0.1, 0.0]\n"}) {
+    REQUIRE(text.find(line) != std::string::npos);
+    text.replace(text.find(line), line.size(), "");
+  }
+  const std::string waves = "[environment.waves]\namplitude = 0.5\nperiod = 8.0\ndirection = 30.0\n";
+  REQUIRE(text.find(waves) != std::string::npos);
+  text.replace(text.find(waves), waves.size(), "");
+  const Files f = write_scenario("rest", text);
+  REQUIRE(test::run_cli(run_args(f, "whole.h5", "--set run.duration=90")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+  for (const std::string hook : {"FLOEDEM_TEST_TERM_AT_STEP=1333 ", "FLOEDEM_TEST_KILL_AT_STEP=1333 "}) {
+    INFO(hook);
+    fs::remove(f.dir / "cut.h5");
+    REQUIRE(test::run_cli(run_args(f, "cut.h5", "--set run.duration=90"), hook).code != 0);
+    const auto resumed = test::run_cli("run --resume " + (f.dir / "cut.h5").string() + " -q");
+    INFO(resumed.output);
+    REQUIRE(resumed.code == 0);
+    check_same_contents(whole, f.dir / "cut.h5");
+  }
+  fs::remove_all(f.dir);
+}
+
+TEST_CASE("resume: an engine without checkpoints stopped by SIGTERM says so and runs again from the start",
+          "[resume][signal]") {
+  if (!test::have_engine("box2d")) return;
+  const Files f = write_scenario("term-box2d");
+  REQUIRE(test::run_cli(run_args(f, "whole.h5", "-e box2d --set run.duration=10")).code == 0);
+  const auto stopped = test::run_cli(run_args(f, "cut.h5", "-e box2d --set run.duration=10"), "FLOEDEM_TEST_TERM_AT_STEP=150 ");
+  INFO(stopped.output);
+  CHECK(stopped.code == 143);
+  CHECK(stopped.output.find("the box2d engine cannot save its state") != std::string::npos);
+  REQUIRE(fs::exists(f.dir / "cut.h5.partial"));
+  REQUIRE(test::run_cli("run --resume " + (f.dir / "cut.h5").string() + " -q").code == 0);
+  check_same_contents(contents(f.dir / "whole.h5"), f.dir / "cut.h5");
+  fs::remove_all(f.dir);
+}
+
 TEST_CASE("resume: an engine without checkpoints runs again from the start, to the same file", "[resume]") {
   if (!test::have_engine("box2d")) return;
   const Files f = write_scenario("box2d");

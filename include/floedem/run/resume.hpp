@@ -21,7 +21,8 @@ struct ResumeResult {
 /// `overrides`: only run.duration=T (a longer run; anything else would not continue the same
 /// run). The scene is rebuilt from the scenario text stored in the file. Throws InputError
 /// (no such run, not a floedem file, another scene, a damaged checkpoint), OutputError,
-/// SolverFailure as run_scene.
-ResumeResult resume_run(const std::string& path, const std::vector<std::string>& overrides, bool progress);
+/// SolverFailure and RunStopped as run_scene; `stop` as RunOptions::stop.
+ResumeResult resume_run(const std::string& path, const std::vector<std::string>& overrides, bool progress,
+                        const std::atomic<bool>* stop = nullptr);
 
 }  // namespace floedem

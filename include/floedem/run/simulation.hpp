@@ -2,6 +2,7 @@
 // The driver: Scene -> Engine -> Recorder, one way. Forcing is evaluated from the engine's
 // state and handed to the engine each step; the recorder sees each step's contacts and every
 // output_every-th state.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <stdexcept>
@@ -26,6 +27,20 @@ struct RunOptions {
   /// Continue from this checkpoint (read_stored_run) instead of starting: output must be the
   /// run's file, which is cut back to the checkpoint and extended (resume.hpp).
   const std::vector<std::uint8_t>* resume_state = nullptr;
+  /// Checked after every step but the last: once true, the run writes a checkpoint of the step
+  /// it has just made (where the engine can save its state) and throws RunStopped, leaving
+  /// RESULT.h5.partial to continue with --resume. `floedem run` sets it on SIGTERM and SIGINT:
+  /// a batch system's notice that the job is about to be killed costs no finished step.
+  const std::atomic<bool>* stop = nullptr;
+};
+
+/// A run stopped on request (RunOptions::stop). Exit code 128 + the signal's number.
+class RunStopped : public std::runtime_error {
+ public:
+  RunStopped(const std::string& m, std::int64_t last_step, bool saved)
+      : std::runtime_error(m), step(last_step), checkpointed(saved) {}
+  std::int64_t step;  ///< the last step made
+  bool checkpointed;  ///< a checkpoint of that step was written (false: the engine cannot save its state)
 };
 
 struct RunSummary {
