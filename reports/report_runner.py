@@ -172,10 +172,12 @@ def cost_lines(runs, owner, launch_seconds, jobs):
             row["longest"] = (r.seconds, r.tag)
     total = sum(x["seconds"] for x in rows.values())
     timed = sum(x["timed"] for x in rows.values())
+    kept = sum(1 for r in runs if r.kept)
+    earlier = f" ({kept} of them made by an earlier launch, at the time it took)" if kept else ""
     md = ["## What this report cost", "",
-          f"{len(runs)} runs, {total:.0f} s of run time (each run's wall time, on one thread unless the section "
-          f"says otherwise), {timed:.0f} s of it timing runs made alone; the launch took {launch_seconds:.0f} s with "
-          f"{jobs} runs at a time. By section, the most costly first:", "",
+          f"{len(runs)} runs{earlier}, {total:.0f} s of run time (each run's wall time, on one thread unless the "
+          f"section says otherwise), {timed:.0f} s of it timing runs made alone; the launch took {launch_seconds:.0f} s "
+          f"with {jobs} runs at a time. By section, the most costly first:", "",
           "| section | runs | run time (s) | share | of it timing runs, alone (s) | longest run (s) |",
           "|---|---|---|---|---|---|"]
     def sec(t):

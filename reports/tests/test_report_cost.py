@@ -38,6 +38,14 @@ def test_sections_are_ranked_by_run_time_and_timings_kept_apart():
     assert abs(sum(float(x[3].rstrip("%")) for x in r.values()) - 100.0) < 0.2
 
 
+def test_runs_kept_from_an_earlier_launch_are_said():
+    runs = [run("a", 10.0), run("b", 5.0)]
+    runs[0].kept = True
+    md = cost_lines(runs, {"a": "towing", "b": "towing"}, 5.0, 2)
+    assert "2 runs (1 of them made by an earlier launch, at the time it took), 15 s of run time" in md[2]
+    assert "earlier launch" not in cost_lines([run("b", 5.0)], {"b": "towing"}, 5.0, 2)[2]
+
+
 def test_no_run_time_gives_zero_shares_not_a_division_by_zero():
     md = cost_lines([run("x", 0.0)], {"x": "impacts"}, 0.0, 1)
     assert rows(md)["impacts"][3] == "0.0%"
