@@ -99,6 +99,13 @@ def continuable(r):
     return not r.timed and r.engine == "native"
 
 
+def continuation(r, floedem):
+    """The Job fields that let floedem.launch continue r's stopped output; none where it cannot."""
+    if not continuable(r):
+        return {}
+    return dict(partial=r.out + ".partial", resume_argv=[floedem, "run", "--resume", r.out + ".partial", "-q"])
+
+
 def run_all(runs, floedem, runs_dir, jobs, label="report", resume=False):
     """Runs every Run into runs_dir through floedem.launch (Snakemake, the project's one way of
     launching runs): `jobs` at a time, the longest first, then the timing runs one at a time,
@@ -134,10 +141,7 @@ def run_all(runs, floedem, runs_dir, jobs, label="report", resume=False):
     share = max(1, cores // max(1, jobs))
     untimed = sorted([r for r in runs if not r.timed], key=lambda r: -r.cost)
     todo = [Job(r.tag, r.command(floedem), threads=r.threads or share, priority=len(untimed) - k + 1000,
-                may_fail=True, stamp=r.stamp, **(dict(partial=r.out + ".partial",
-                                                      resume_argv=[floedem, "run", "--resume", r.out + ".partial", "-q"])
-                                                 if continuable(r) else {}))
-            for k, r in enumerate(untimed)]
+                may_fail=True, stamp=r.stamp, **continuation(r, floedem)) for k, r in enumerate(untimed)]
     ids = [j.id for j in todo]
     todo += [Job(r.tag, r.command(floedem), threads=r.threads or 1, alone=True, after=ids, may_fail=True,
                  stamp=r.stamp) for r in runs if r.timed]

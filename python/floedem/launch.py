@@ -158,12 +158,14 @@ def run_one(launch_json, job_id, threads):
     job = next(j for j in spec["jobs"] if j["id"] == job_id)
     meta = os.path.dirname(launch_json)
     done = os.path.join(meta, "done")
-    started = os.path.join(meta, "started", job_id + ".json")
-    os.makedirs(os.path.dirname(started), exist_ok=True)
     env = dict(os.environ, FLOEDEM_THREADS=str(max(1, job["threads"] if job["alone"] else threads)))
     partial, resume = job.get("partial", ""), job.get("resume_argv", [])
-    continued = bool(partial and resume and os.path.exists(partial) and _started_here(started, job))
-    write_atomic(started, json.dumps(dict(argv=job["argv"], stamp=job.get("stamp", ""))))
+    continued = False
+    if partial and resume:   # only a job that can be continued keeps a record of its tries
+        started = os.path.join(meta, "started", job_id + ".json")
+        os.makedirs(os.path.dirname(started), exist_ok=True)
+        continued = os.path.exists(partial) and _started_here(started, job)
+        write_atomic(started, json.dumps(dict(argv=job["argv"], stamp=job.get("stamp", ""))))
     t0 = time.monotonic()
     p = subprocess.run(resume if continued else job["argv"], capture_output=True, text=True, env=env)
     seconds = time.monotonic() - t0
