@@ -362,6 +362,11 @@ int failure_status(const std::exception_ptr& error) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A file-size limit on the process (ulimit -f, RLIMIT_FSIZE: a batch system passes on the
+  // submitting shell's) sends SIGXFSZ on the write that crosses it, whose default action kills
+  // the run without a word. Ignored, the write fails with EFBIG instead, which the recorder
+  // reports as any failed write: one line, exit 3, the .partial kept for --resume.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"floedem: planar non-smooth DEM of icebergs drifting or towed through broken sea ice"};
   // The library's version and the output layout it writes and reads, as a run's file stores them
   // (root attributes floedem_version and format_version).
