@@ -79,12 +79,18 @@ bool IslandSolver::approaching(std::span<const Manifold> manifolds, const BodyAr
   return normal_velocity(manifolds[points_[i].manifold], q, s) < q.target_velocity - tolerance;
 }
 
-bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays& s, double trigger_velocity,
+bool IslandSolver::needs_solve(const Manifold& m, const ManifoldPoint& q, const BodyArrays& s) const {
+  const double f = shortfall(m, q, s);
+  return f > trigger_.creep &&
+         (f > trigger_.closing || std::max(-q.separation, 0.0) + f * trigger_.dt > trigger_.allowed_overlap);
+}
+
+bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays& s, const Trigger& trigger,
                           double mass_ratio) {
-  trigger_velocity_ = trigger_velocity;
-  // 1. Is there a point left approaching beyond its target by more than the trigger?
+  trigger_ = trigger;
+  // 1. Is there a point left approaching beyond its target by more than the creep?
   points_.clear();
-  if (largest_shortfall(manifolds, s) <= trigger_velocity) return false;
+  if (largest_shortfall(manifolds, s) <= trigger.creep) return false;
 
   // 2. Islands (contact_islands.hpp); the points of those holding such a point whose heaviest
   // body is at least mass_ratio times their lightest.
@@ -100,7 +106,7 @@ bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays&
     if (!(largest_inv_mass >= mass_ratio * smallest_inv_mass)) continue;
     for (const std::int32_t k : islands_.manifolds(i)) {
       const Manifold& m = manifolds[static_cast<std::size_t>(k)];
-      for (int q = 0; q < m.point_count; ++q) chosen_[i] = chosen_[i] || shortfall(m, m.points[q], s) > trigger_velocity;
+      for (int q = 0; q < m.point_count; ++q) chosen_[i] = chosen_[i] || needs_solve(m, m.points[q], s);
     }
     any = any || chosen_[i];
   }
@@ -141,7 +147,7 @@ bool IslandSolver::solve(std::span<Manifold> manifolds, BodyArrays& s, bool with
     free_velocity_[i] = normal_velocity(manifolds[points_[i].manifold], point(manifolds, i), s);
 
   // 4. Block principal pivoting.
-  const double tolerance = 1e-2 * trigger_velocity_;  // m/s, left as solved
+  const double tolerance = trigger_.tolerance;  // m/s, left as solved
   refine_to_ = 1e-2 * tolerance;
   std::size_t best_wrong = np + 1;
   int rounds_without_progress = 0;
@@ -196,7 +202,7 @@ bool IslandSolver::solve_by_descent(std::span<const Manifold> manifolds, BodyArr
   // those at 0; then take in the point approaching most. Each step lowers the objective, so
   // it does not cycle as pivoting can.
   const std::size_t np = points_.size();
-  const double tolerance = 1e-2 * trigger_velocity_;
+  const double tolerance = trigger_.tolerance;
   std::vector<double>& now = start_;  // feasible impulses, Gauss-Seidel's to begin with
   for (std::size_t i = 0; i < np; ++i) active_[i] = now[i] > 0.0;
   const int limit = 4 * static_cast<int>(np) + 10;

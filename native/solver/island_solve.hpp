@@ -16,11 +16,20 @@ namespace floedem {
 
 class IslandSolver {
  public:
-  /// Chooses the islands to solve: those holding a point that still approaches faster than its
-  /// target by more than `trigger_velocity` (m/s) and whose heaviest body is at least
-  /// `mass_ratio` times their lightest. Islands: bodies joined by contacts; fixed and
-  /// prescribed bodies (infinite mass) join nothing. Returns whether there is any.
-  bool select(std::span<const Manifold> manifolds, const BodyArrays& bodies, double trigger_velocity, double mass_ratio);
+  /// When a point needs the direct solve, and how far it solves (m/s, m, s). A point needs it
+  /// when it is left approaching faster than its target by more than `creep`, and either by
+  /// more than `closing` or by enough to end the step of `dt` deeper than `allowed_overlap`
+  /// (its overlap now plus the shortfall times dt). The solve leaves every normal velocity
+  /// within `tolerance` of its law.
+  struct Trigger {
+    double creep = 0.0, closing = 0.0, dt = 0.0, allowed_overlap = 0.0, tolerance = 0.0;
+  };
+
+  /// Chooses the islands to solve: those holding a point that needs it (Trigger) and whose
+  /// heaviest body is at least `mass_ratio` times their lightest. Islands: bodies joined by
+  /// contacts; fixed and prescribed bodies (infinite mass) join nothing. Returns whether there
+  /// is any.
+  bool select(std::span<const Manifold> manifolds, const BodyArrays& bodies, const Trigger& trigger, double mass_ratio);
 
   /// Solves the normal impulses of the chosen islands directly, friction held as it is (or
   /// taken off, without_friction), and updates impulses and velocities; returns false and
@@ -41,6 +50,7 @@ class IslandSolver {
   }
   static double normal_velocity(const Manifold& m, const ManifoldPoint& q, const BodyArrays& bodies);
   static double shortfall(const Manifold& m, const ManifoldPoint& q, const BodyArrays& bodies);  ///< u* - u_n
+  bool needs_solve(const Manifold& m, const ManifoldPoint& q, const BodyArrays& bodies) const;  ///< Trigger
   void apply(std::span<const Manifold> manifolds, BodyArrays& bodies, std::size_t i, double pn, double pt) const;
   /// Velocities: the free ones plus every point's normal_ impulse.
   void apply_normals(std::span<const Manifold> manifolds, BodyArrays& bodies) const;
@@ -68,7 +78,7 @@ class IslandSolver {
   Eigen::SparseMatrix<double> a_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
   double refine_to_ = 0.0;  // m/s: the velocity residual the refinement stops at
-  double trigger_velocity_ = 0.0;
+  Trigger trigger_;
 };
 
 }  // namespace floedem

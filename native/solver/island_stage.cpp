@@ -203,7 +203,12 @@ int IslandStage::solve_island(StepContext& ctx, std::span<Manifold> manifolds_al
                               island_bundles_[island + 1] - island_bundles_[island]);
     space.colours_given = true;  // by solve()
   }
-  const SweepLimits limits = sweep_limits(ctx, manifolds.size());
+  SweepLimits limits = sweep_limits(ctx, manifolds.size());
+  // A heavy-light island gets no extra sweeps: they run only while a point closes by more than
+  // the allowed overlap in the step, which triggers the direct solve anyway (solve_islands_directly),
+  // and the sweeps of such an island hand on m / M of the reaction a sweep: up to
+  // extra_iterations of them, only to be solved directly after all.
+  if (heavy_light_ && heavy_light_island(ctx, bodies)) limits.extra_iterations = 0;
   // Out of sweeps: the island spent its count (the direct solve's trigger looks then).
   auto spent = [&](int sweeps) {
     if (sweeps >= limits.iterations) work.out_of_sweeps = true;
@@ -237,14 +242,43 @@ int IslandStage::solve_island(StepContext& ctx, std::span<Manifold> manifolds_al
   return spent(sweeps);
 }
 
+bool IslandStage::heavy_light_island(const StepContext& ctx, std::span<const std::int32_t> bodies) const {
+  double largest_inv_mass = 0.0, smallest_inv_mass = std::numeric_limits<double>::infinity();
+  for (const std::int32_t b : bodies) {
+    largest_inv_mass = std::max(largest_inv_mass, ctx.bodies.inv_mass[b]);
+    smallest_inv_mass = std::min(smallest_inv_mass, ctx.bodies.inv_mass[b]);
+  }
+  return largest_inv_mass >= ctx.settings.direct_solve_mass_ratio * smallest_inv_mass;
+}
+
 void IslandStage::solve_islands_directly(StepContext& ctx, std::span<Manifold> manifolds, double before) {
-  // Trigger: a point still approaching faster than its target by 1e-3 of allowed_penetration /
-  // dt (a creep of 1e-3 of the allowed overlap per step, which the position projection cannot
-  // take back in a heavy-light chain either), in an island of mass ratio direct_solve_mass_ratio.
+  // Trigger (IslandSolver::Trigger), in an island of mass ratio direct_solve_mass_ratio: a
+  // point the sweeps leave approaching faster than its target (u* - u_n > 0: the overlap the
+  // step adds, over dt, since a resting point's target is -gap / dt) by more than 1e-3 of
+  // allowed_penetration / dt, and either by more than allowed_penetration / dt (the step alone
+  // adds more than the allowed overlap) or by enough to leave it deeper than the allowed
+  // overlap. In a heavy-light chain the position projection, Gauss-Seidel too, cannot take an
+  // overlap back, so a creep that goes on step after step (an iceberg the sweeps leave pressing
+  // at 5 mm/s on floes against a wall) must be solved before it passes the allowed overlap. A
+  // point that creeps within it is left to the sweeps: in a jammed pack about a heavy iceberg
+  // most points creep by a little, and solving each of those steps directly (with its friction
+  // sweeps, four times the sweeps alone) holds no overlap that the sweeps do not. Once
+  // triggered, the solve holds every normal velocity to 1e-5 allowed_penetration / dt (an
+  // overlap growing by 1e-8 m a step at the defaults).
   const NativeSettings& settings = ctx.settings;
   BodyArrays& s = ctx.bodies;
-  const double trigger = 1e-3 * settings.allowed_penetration / ctx.dt;
+  const double closing_speed = settings.allowed_penetration / ctx.dt;
+  const IslandSolver::Trigger trigger{.creep = 1e-3 * closing_speed,
+                                      .closing = closing_speed,
+                                      .dt = ctx.dt,
+                                      .allowed_overlap = settings.allowed_penetration,
+                                      .tolerance = 1e-5 * closing_speed};
   if (!island_solver_.select(manifolds, s, trigger, settings.direct_solve_mass_ratio)) return;
+  // Once an island is solved, its normals are solved again wherever the sweeps that follow
+  // (below) leave a point approaching beyond the creep alone: they end the step exact, not
+  // merely within the allowed overlap.
+  IslandSolver::Trigger again = trigger;
+  again.closing = trigger.creep;
   saved_impulses_.clear();
   for (const Manifold& m : manifolds)
     for (int k = 0; k < m.point_count; ++k) {
@@ -274,7 +308,7 @@ void IslandStage::solve_islands_directly(StepContext& ctx, std::span<Manifold> m
   for (const std::int32_t k : island_index_) island_manifolds_.push_back(manifolds[static_cast<std::size_t>(k)]);
   // The normals again with friction held, where a point is still left beyond the trigger.
   auto solve_normals_again = [&] {
-    return island_solver_.select(island_manifolds_, s, trigger, settings.direct_solve_mass_ratio) &&
+    return island_solver_.select(island_manifolds_, s, again, settings.direct_solve_mass_ratio) &&
            island_solver_.solve(island_manifolds_, s, /*without_friction=*/false);
   };
   for (int pass = 0; pass < 3; ++pass) {

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "floedem/run/simulation.hpp"
+#include "solver/island_solve.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -77,4 +78,55 @@ TEST_CASE("island solve: a chain held for 20 s stays within the allowed overlap,
   auto light_engine = test::native(light);
   for (int k = 0; k < 40; ++k) light_engine->step(nullptr);
   CHECK(light_engine->info().settings.at("direct_solves") == "0");
+}
+
+namespace {
+
+// One contact between a light floe (body 0, 99 kg) and an iceberg (body 1, 1e8 kg), normal
+// along x from the floe to the iceberg, its floe approaching the iceberg at `closing` m/s
+// beyond its target, overlapping by `overlap` m.
+struct OnePoint {
+  BodyArrays bodies;
+  std::vector<Manifold> manifolds{1};
+  OnePoint(double closing, double overlap) {
+    bodies.position = {{0.0, 0.0}, {6.0, 0.0}};
+    bodies.angle = {0.0, 0.0};
+    bodies.velocity = {{closing, 0.0}, {0.0, 0.0}};
+    bodies.angular_velocity = {0.0, 0.0};
+    bodies.inv_mass = {1.0 / 99.0, 1e-8};
+    bodies.inv_inertia = {0.0, 0.0};
+    Manifold& m = manifolds[0];
+    m.body_a = 0;
+    m.body_b = 1;
+    m.normal = {1.0, 0.0};
+    m.point_count = 1;
+    m.points[0].separation = -overlap;
+    m.points[0].wnn = 1.0 / 99.0 + 1e-8;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("island solve: a heavy-light point is solved when it would pass the allowed overlap, not for a creep within it",
+          "[island]") {
+  // The engine's trigger at dt = 0.05 s and allowed_penetration = 1 mm: closing speed 0.02 m/s,
+  // creep 2e-5 m/s (island_stage.cpp).
+  const IslandSolver::Trigger trigger{.creep = 2e-5, .closing = 0.02, .dt = 0.05, .allowed_overlap = 1e-3,
+                                      .tolerance = 2e-7};
+  auto selected = [&](double closing, double overlap) {
+    OnePoint p(closing, overlap);
+    IslandSolver solver;
+    return solver.select(p.manifolds, p.bodies, trigger, 300.0);
+  };
+  CHECK(selected(0.03, 0.0));        // the step alone adds 1.5 mm
+  CHECK_FALSE(selected(0.01, 0.0));  // 0.5 mm, and none yet: the sweeps' answer stands
+  CHECK(selected(0.01, 0.6e-3));     // 0.5 mm more on 0.6 mm passes 1 mm
+  CHECK(selected(1e-4, 0.999e-3));   // a slow creep at the allowed overlap
+  CHECK_FALSE(selected(1e-5, 2e-3)); // below the creep: rounding, whatever the overlap
+  CHECK_FALSE(selected(-0.01, 0.0)); // separating
+  // Equal masses: never, however fast (the mass ratio).
+  OnePoint light(0.5, 0.0);
+  light.bodies.inv_mass[1] = 1.0 / 99.0;
+  IslandSolver solver;
+  CHECK_FALSE(solver.select(light.manifolds, light.bodies, trigger, 300.0));
 }
