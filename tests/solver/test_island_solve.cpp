@@ -39,7 +39,7 @@ TEST_CASE("island solve: an iceberg 1e8 times a floe's mass is stopped by the fl
     const double before = kinetic_energy(s, engine->state());
     engine->step(nullptr);
     const BodyStates& b = engine->state();
-    // Normal velocities to the solve's tolerance: 1e-2 of its trigger, 1e-3 allowed_penetration
+    // Normal velocities to the solve's tolerance: 1e-2 of its creep, 1e-3 allowed_penetration
     // / dt = 2e-5 m/s (an overlap growing by 1e-8 m a step). Sideways the floes stay put: the
     // first solve takes the sweeps' friction off (found against their wrong normals, held it
     // threw these floes sideways at up to 4e-4 m/s) and the sweeps rebuild it against the exact
