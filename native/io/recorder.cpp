@@ -652,7 +652,7 @@ Recorder::~Recorder() {
     }
   }
   // After a failed write the file's datasets cannot be closed either, and the HDF5 C++ API's
-  // destructors say so on stderr, a line each (25 for a run's file), after which the one-line
+  // destructors say so on stderr, a line a dataset, after which the one-line
   // error would come last. Their handles are left to the end of the process instead (the
   // command exits at once, without exit handlers: app/main.cpp).
   if (impl_ && impl_->write_failed) static_cast<void>(impl_.release());

@@ -79,6 +79,15 @@ bool IslandSolver::approaching(std::span<const Manifold> manifolds, const BodyAr
   return normal_velocity(manifolds[points_[i].manifold], q, s) < q.target_velocity - tolerance;
 }
 
+bool IslandSolver::heavy_light(std::span<const std::int32_t> bodies, const BodyArrays& s, double mass_ratio) {
+  double largest_inv_mass = 0.0, smallest_inv_mass = std::numeric_limits<double>::infinity();
+  for (const std::int32_t body : bodies) {
+    largest_inv_mass = std::max(largest_inv_mass, s.inv_mass[body]);
+    smallest_inv_mass = std::min(smallest_inv_mass, s.inv_mass[body]);
+  }
+  return largest_inv_mass >= mass_ratio * smallest_inv_mass;
+}
+
 bool IslandSolver::needs_solve(const Manifold& m, const ManifoldPoint& q, const BodyArrays& s) const {
   const double f = shortfall(m, q, s);
   return f > trigger_.creep &&
@@ -98,12 +107,7 @@ bool IslandSolver::select(std::span<const Manifold> manifolds, const BodyArrays&
   chosen_.assign(islands_.size(), 0);
   bool any = false;
   for (std::size_t i = 0; i < islands_.size(); ++i) {
-    double largest_inv_mass = 0.0, smallest_inv_mass = std::numeric_limits<double>::infinity();
-    for (const std::int32_t body : islands_.bodies(i)) {
-      largest_inv_mass = std::max(largest_inv_mass, s.inv_mass[body]);
-      smallest_inv_mass = std::min(smallest_inv_mass, s.inv_mass[body]);
-    }
-    if (!(largest_inv_mass >= mass_ratio * smallest_inv_mass)) continue;
+    if (!heavy_light(islands_.bodies(i), s, mass_ratio)) continue;
     for (const std::int32_t k : islands_.manifolds(i)) {
       const Manifold& m = manifolds[static_cast<std::size_t>(k)];
       for (int q = 0; q < m.point_count; ++q) chosen_[i] = chosen_[i] || needs_solve(m, m.points[q], s);

@@ -25,6 +25,9 @@ class IslandSolver {
     double creep = 0.0, closing = 0.0, dt = 0.0, allowed_overlap = 0.0, tolerance = 0.0;
   };
 
+  /// Whether the heaviest of these moving bodies is at least `mass_ratio` times the lightest.
+  static bool heavy_light(std::span<const std::int32_t> bodies, const BodyArrays& s, double mass_ratio);
+
   /// Chooses the islands to solve: those holding a point that needs it (Trigger) and whose
   /// heaviest body is at least `mass_ratio` times their lightest. Islands: bodies joined by
   /// contacts; fixed and prescribed bodies (infinite mass) join nothing. Returns whether there

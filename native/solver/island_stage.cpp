@@ -208,7 +208,8 @@ int IslandStage::solve_island(StepContext& ctx, std::span<Manifold> manifolds_al
   // the allowed overlap in the step, which triggers the direct solve anyway (solve_islands_directly),
   // and the sweeps of such an island hand on m / M of the reaction a sweep: up to
   // extra_iterations of them, only to be solved directly after all.
-  if (heavy_light_ && heavy_light_island(ctx, bodies)) limits.extra_iterations = 0;
+  if (heavy_light_ && IslandSolver::heavy_light(bodies, s, ctx.settings.direct_solve_mass_ratio))
+    limits.extra_iterations = 0;
   // Out of sweeps: the island spent its count (the direct solve's trigger looks then).
   auto spent = [&](int sweeps) {
     if (sweeps >= limits.iterations) work.out_of_sweeps = true;
@@ -240,15 +241,6 @@ int IslandStage::solve_island(StepContext& ctx, std::span<Manifold> manifolds_al
                              {.colour = colour, .threads = threads});
   ++work.cold_restarts;
   return spent(sweeps);
-}
-
-bool IslandStage::heavy_light_island(const StepContext& ctx, std::span<const std::int32_t> bodies) const {
-  double largest_inv_mass = 0.0, smallest_inv_mass = std::numeric_limits<double>::infinity();
-  for (const std::int32_t b : bodies) {
-    largest_inv_mass = std::max(largest_inv_mass, ctx.bodies.inv_mass[b]);
-    smallest_inv_mass = std::min(smallest_inv_mass, ctx.bodies.inv_mass[b]);
-  }
-  return largest_inv_mass >= ctx.settings.direct_solve_mass_ratio * smallest_inv_mass;
 }
 
 void IslandStage::solve_islands_directly(StepContext& ctx, std::span<Manifold> manifolds, double before) {
@@ -306,7 +298,7 @@ void IslandStage::solve_islands_directly(StepContext& ctx, std::span<Manifold> m
   island_index_.assign(island_solver_.island_manifolds().begin(), island_solver_.island_manifolds().end());
   island_manifolds_.clear();
   for (const std::int32_t k : island_index_) island_manifolds_.push_back(manifolds[static_cast<std::size_t>(k)]);
-  // The normals again with friction held, where a point is still left beyond the trigger.
+  // The normals again with friction held, where a point is still left beyond the creep.
   auto solve_normals_again = [&] {
     return island_solver_.select(island_manifolds_, s, again, settings.direct_solve_mass_ratio) &&
            island_solver_.solve(island_manifolds_, s, /*without_friction=*/false);

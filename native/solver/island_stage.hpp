@@ -48,8 +48,6 @@ class IslandStage {
     return static_cast<std::int64_t>(islands_.manifolds(i).size()) >= ctx.settings.coloured_from;
   }
   void solve_islands_directly(StepContext& ctx, std::span<Manifold> manifolds, double energy_before);
-  /// Whether the heaviest of these moving bodies is direct_solve_mass_ratio times the lightest.
-  bool heavy_light_island(const StepContext& ctx, std::span<const std::int32_t> bodies) const;
   /// Whether an island of `manifolds` manifolds is large (NativeSettings::large_island_manifolds).
   static bool large_island(const StepContext& ctx, std::size_t manifolds) {
     return static_cast<std::int64_t>(manifolds) >= ctx.settings.large_island_manifolds;
