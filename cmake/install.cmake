@@ -14,7 +14,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/floedem DESTINATION ${CMAKE_INST
   FILES_MATCHING PATTERN "*.hpp")
 install(EXPORT floedemTargets NAMESPACE floedem:: DESTINATION ${FLOEDEM_CMAKE_DIR})
 set(FLOEDEM_ENGINE_NAMES native)
-foreach(_engine IN ITEMS BOX2D BULLET ODE)
+foreach(_engine IN ITEMS BOX2D BULLET MUJOCO ODE)
   if(FLOEDEM_WITH_${_engine})
     string(TOLOWER ${_engine} _lower)
     list(APPEND FLOEDEM_ENGINE_NAMES ${_lower})

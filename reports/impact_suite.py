@@ -28,7 +28,9 @@ import floedem  # noqa: E402
 from report_runner import Run, run_all  # noqa: E402
 
 SCENARIOS = ["floe_structure_headon", "floe_structure_oblique", "floe_floe_headon", "floe_floe_oblique"]
-COMPLIANT = ["native", "ode", "bullet"]   # native estimates, the two compliant references measure
+COMPLIANT = ["native", "ode", "bullet", "mujoco"]   # native estimates, the compliant references measure
+# MuJoCo's contacts are soft by construction: it has no rigid (impulse) contact to run in the first part.
+SOFT_ONLY = ["mujoco"]
 C_TAU = 1.5e-4        # s kg^-1/2, the scenarios' duration_coefficient
 STEPS_PER_PULSE = 40  # dt = tau / 40
 RIGID_E = (0.0, 0.1, 0.5, 0.9)
@@ -42,12 +44,14 @@ RIGID_E = (0.0, 0.1, 0.5, 0.9)
 #   holds for a single point along the line of centres. ODE's soft contact within 15 % of it (up to
 #   11 % measured, on the oblique cases, where the lever arm moves during the pulse), Bullet within
 #   25 % (up to 22 % measured: it drops and re-adds manifold points during the deep pulses of the
-#   heaviest floes, which delays the release; tests/reference/test_compliant.cpp); exponent of tau
+#   heaviest floes, which delays the release; tests/reference/test_compliant.cpp); MuJoCo
+#   within 15 % (13 % short to 9 % long measured at 10 substeps a step, on the 1 km floes, where its collider
+#   loses relative precision on prisms 1.4 km tall and finds the face's points late); exponent of tau
 #   on m_eff 0.5 +- 0.05 on every engine (a Hertzian contact would give 0.4).
 TOL_E = 0.005
 TOL_J_HEADON = 1e-3
 TOL_J_OBLIQUE = 5e-3
-TOL_TC = {"ode": 0.15, "bullet": 0.25}
+TOL_TC = {"ode": 0.15, "bullet": 0.25, "mujoco": 0.15}
 TOL_EXPONENT = 0.05
 
 
@@ -92,6 +96,11 @@ def duration_case(name, engine, side, speed_scale, extra=(), part="duration"):
             sets.append(f"body[{k}].velocity=[{vx * speed_scale!r}, {vy * speed_scale!r}]")
     if engine in ("ode", "bullet"):
         sets.append(f"engine.{engine}.contact_model=compliant")
+    if engine == "mujoco":
+        # 10 substeps a step, 400 a pulse: MuJoCo's face contacts release early by an error of
+        # first order in the substep (26 % at 40 substeps a pulse, 9 % at 160, 1 % at 400;
+        # docs/engines.md), from the multi-point collision's points that come and go.
+        sets.append("engine.mujoco.substeps=10")
     sets += list(extra)
     tag = "_".join(["impact", name, engine, f"L{side:.4g}", f"v{speed_scale:g}"] +
                    [e.split("=")[0].split(".")[-1] + e.split("=")[1] for e in extra])
@@ -103,7 +112,7 @@ def plan(quick, engines):
     """Every run of the suite."""
     runs = []
     for name in SCENARIOS:
-        for engine in engines:
+        for engine in (e for e in engines if e not in SOFT_ONLY):
             for e in RIGID_E:
                 runs.append(Run(f"impact_{name}_{engine}_rigid_e{e:g}", scenario_path(name), engine,
                                 [f"contact.restitution={e!r}"], cost=0.05,
@@ -173,7 +182,7 @@ def summarize(runs, rel_to, fig_dir, quick):
     dur = [x for x in rows if x["part"] == "duration"]
     sens = [x for x in rows if x["part"] == "sensitivity"]
     engines = sorted({x["engine"] for x in rigid}, key=lambda e: (e != "native", e))
-    compliant = [e for e in COMPLIANT if e in engines]   # those this build has
+    compliant = [e for e in COMPLIANT if any(x["engine"] == e for x in dur)]   # those this build has
     fails = []
     md = ["## Impacts: impulses and restitution", "",
           "Each engine with its rigid (impulse) contact on the four cases of `scenarios/impacts/` (10 m floes, "
@@ -212,7 +221,7 @@ def summarize(runs, rel_to, fig_dir, quick):
            "| engine | exponent of tau on m_eff | m_eff range (kg) | measured / t_c (mean, range) | cases |",
            "|---|---|---|---|---|"]
     fig, ax = plt.subplots(figsize=(7, 5))
-    marks = {"native": "o", "ode": "s", "bullet": "^"}
+    marks = {"native": "o", "ode": "s", "bullet": "^", "mujoco": "D"}
     for engine in compliant:
         sel = [x for x in dur if x["engine"] == engine]
         m = np.array([x["effective_mass"] for x in sel])
@@ -245,7 +254,7 @@ def summarize(runs, rel_to, fig_dir, quick):
            "masses and speeds; 1 / 0.741 = 1.35 expected from t_c alone):", "",
            "| case | reference | duration ratio | peak force ratio |", "|---|---|---|---|"]
     for name in SCENARIOS:
-        for ref in (e for e in ("ode", "bullet") if e in engines):
+        for ref in (e for e in ("ode", "bullet", "mujoco") if e in compliant):
             dr, pr = [], []
             for r in dur:
                 if r["engine"] != ref or r["scenario"] != name:
@@ -337,7 +346,7 @@ def main():
     ap.add_argument("--quick", action="store_true", help="three sizes, two speeds")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     a = ap.parse_args()
-    runs = plan(a.quick, ["native", "box2d", "bullet", "ode"])
+    runs = plan(a.quick, ["native", "box2d", "bullet", "ode", "mujoco"])
     failed = run_all(runs, a.floedem, os.path.join(a.out, "runs"), a.jobs, "impacts")
     if failed:
         raise SystemExit(f"impact_suite: {len(failed)} runs failed")

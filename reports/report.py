@@ -28,12 +28,16 @@ from sections.speed import load_stage_labels  # noqa: E402
 
 
 REFERENCE_ENGINES = ["box2d", "bullet", "ode"]   # floedem's own references (docs/engines.md)
+# References that join only the sections measured with them: MuJoCo's contact is the scene's
+# spring-dashpot, whose shortest pulse on a towing field asks for 66 substeps of dt = 0.1 s
+# (about 3 h a towing run on one core; docs/engines.md), so it runs the impact suite alone.
+PARTIAL_ENGINES = {"mujoco": ["impacts"]}
 
 
 class Context:
     """What every section sees: the options, where things go, and the runs by tag."""
 
-    def __init__(self, a, engines):
+    def __init__(self, a, engines, partial):
         self.floedem = a.floedem
         self.quick = a.quick
         self.out = os.path.abspath(a.out)
@@ -41,6 +45,7 @@ class Context:
         self.runs_dir = os.path.join(self.out, "runs")
         self.scenarios = os.path.join(ROOT, "scenarios")
         self.engines = engines          # native first
+        self.partial = partial          # engine -> the sections it joins (PARTIAL_ENGINES)
         self.all_runs = []
         self.jobs = a.jobs              # runs at a time
         self.launch_seconds = 0.0       # wall time of launching every run (report_runner.run_all)
@@ -96,13 +101,14 @@ def main():
     commit = git_commit()   # now: the tree the runs are made from
     version = floedem_text(a.floedem, "--version").strip()
     listed = [line.split("\t")[0] for line in floedem_text(a.floedem, "engines").splitlines() if line.strip()]
-    engines = ["native"] + [e for e in listed if e != "native"]
+    engines = ["native"] + [e for e in listed if e != "native" and e not in PARTIAL_ENGINES]
+    partial = {e: PARTIAL_ENGINES[e] for e in listed if e in PARTIAL_ENGINES}
     # A build configured without a reference engine (FLOEDEM_WITH_ODE=OFF, ...) reports on the
     # engines it has; what it skips is said here and at the head of the report.
     missing = [e for e in REFERENCE_ENGINES if e not in engines]
     if missing:
         print(f"report: this build has no {', '.join(missing)} engine: their runs and checks are skipped", flush=True)
-    ctx = Context(a, engines)
+    ctx = Context(a, engines, partial)
     load_stage_labels(a.floedem)
     # Nothing in the report may come from an earlier run, except, with --resume, runs of the same
     # program, command and inputs (report_runner.run_all checks each): the runs are deterministic.

@@ -6,9 +6,9 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config clang
-  libeigen3-dev libode-dev libbullet-dev libbox2d-dev libcgal-dev
+  libeigen3-dev libode-dev libbullet-dev libbox2d-dev libmujoco-dev libcgal-dev
   libhdf5-dev hdf5-tools libnetcdf-dev libproj-dev libgdal-dev catch2 libtomlplusplus-dev libcli11-dev libbenchmark-dev
-  python3 python3-numpy python3-h5py python3-matplotlib python3-pytest python3-netcdf4 python3-pyproj
+  python3 python3-numpy python3-scipy python3-h5py python3-matplotlib python3-pytest python3-netcdf4 python3-pyproj
   # Films (floedem animate) and ParaView's reader, which the tests read the XDMF export back with.
   ffmpeg python3-paraview
   # Sweeps and the report's runs are launched by Snakemake.

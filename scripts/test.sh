@@ -34,7 +34,7 @@ case "$mode" in
     ;;
   --no-reference)
     build="${FLOEDEM_BUILD_DIR:-$root/build-native}"
-    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DFLOEDEM_WITH_ODE=OFF -DFLOEDEM_WITH_BULLET=OFF \
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DFLOEDEM_WITH_ODE=OFF -DFLOEDEM_WITH_BULLET=OFF -DFLOEDEM_WITH_MUJOCO=OFF \
       -DFLOEDEM_WITH_BOX2D=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
     cmake --build "$build" -j "$jobs"
     ;;

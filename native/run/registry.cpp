@@ -11,6 +11,9 @@
 #ifdef FLOEDEM_WITH_BULLET
 #include "reference/bullet/bullet_engine.hpp"
 #endif
+#ifdef FLOEDEM_WITH_MUJOCO
+#include "reference/mujoco/mujoco_engine.hpp"
+#endif
 #ifdef FLOEDEM_WITH_ODE
 #include "reference/ode/ode_engine.hpp"
 #endif
@@ -31,6 +34,10 @@ std::vector<EngineEntry>& table() {
       {"bullet", "Bullet 3 double (reference): extruded prisms held in the plane, split impulse, max/min combine",
        make_bullet_engine},
 #endif
+#ifdef FLOEDEM_WITH_MUJOCO
+      {"mujoco", "MuJoCo 2.2 (reference): soft contacts by convex optimisation, extruded prisms on planar joints",
+       make_mujoco_engine},
+#endif
 #ifdef FLOEDEM_WITH_ODE
       {"ode", "ODE 0.16 double (reference): plane-2D joints, QuickStep, contact points from floedem's 2-D narrow phase",
        make_ode_engine},
@@ -46,7 +53,7 @@ std::string upper(std::string s) {
   return s;
 }
 
-constexpr const char* kReferenceNames[] = {"box2d", "bullet", "ode"};
+constexpr const char* kReferenceNames[] = {"box2d", "bullet", "mujoco", "ode"};
 
 }  // namespace
 

@@ -188,6 +188,24 @@ std::vector<Vec2> TableReader::points(std::string_view key) {
   return out;
 }
 
+std::vector<double> TableReader::reals(std::string_view key, std::vector<double> fallback, const std::vector<Range>& ranges) {
+  const std::string shape = "an array of " + std::to_string(ranges.size()) + " numbers";
+  const toml::node* n = lookup(key);
+  if (!n) return fallback;
+  const toml::array* a = n->as_array();
+  if (!a) fail(key, "expected " + shape + ", got " + type_name(*n));
+  if (a->size() != ranges.size()) fail(key, "expected " + shape + ", got " + std::to_string(a->size()));
+  std::vector<double> out;
+  for (std::size_t i = 0; i < ranges.size(); ++i) {
+    const auto c = as_real(*a->get(i));
+    if (!c) fail(key, "entry " + std::to_string(i) + " is " + type_name(*a->get(i)) + ", expected a number");
+    if (!std::isfinite(*c) || !ranges[i].contains(*c))
+      fail(key, "entry " + std::to_string(i) + " is " + format_number(*c) + ", allowed " + ranges[i].describe());
+    out.push_back(*c);
+  }
+  return out;
+}
+
 std::vector<std::vector<double>> TableReader::rows(std::string_view key, std::size_t width) {
   const std::string shape = "an array of rows of " + std::to_string(width) + " numbers";
   const toml::node* n = lookup(key);

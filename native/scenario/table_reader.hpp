@@ -49,6 +49,9 @@ class TableReader {
   std::vector<std::string> strings(std::string_view key);
   /// An array of [x, y] points (no further checks here).
   std::vector<Vec2> points(std::string_view key);
+  /// An array of as many finite numbers as `ranges` has entries, entry i within ranges[i];
+  /// `fallback` when the key is absent.
+  std::vector<double> reals(std::string_view key, std::vector<double> fallback, const std::vector<Range>& ranges);
   /// An array of rows of `width` finite numbers each (at least one row).
   std::vector<std::vector<double>> rows(std::string_view key, std::size_t width);
   /// A sub-table, or nullptr when absent; an error when present with another type.

@@ -4,7 +4,7 @@ import impact_suite
 
 
 def plan(ctx):
-    return impact_suite.plan(ctx.quick, ctx.engines)
+    return impact_suite.plan(ctx.quick, ctx.engines + [e for e, where in ctx.partial.items() if "impacts" in where])
 
 
 def write(ctx):

@@ -18,6 +18,7 @@
 
 #include "contacts/collision_forces.hpp"
 #include "run/stepper.hpp"
+#include "reference/compliant_pulse.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -41,20 +42,10 @@ Measured impact(const std::string& engine, double h, double e) {
   const BodyText wall{"wall", test::box({10.0, 0.0}, 10.0, 40.0), {}, 0.0, true};
   const Scene s = test::scene_from(test::header_toml(4.0 * tau, dt, e, 0.0, extra.str()) + test::body_toml(floe) +
                                    test::body_toml(wall));
-  Stepper stepper(s, engine);
-  CollisionTracker tracker(s, duration_model_of(stepper.engine().info()));
-  std::vector<CollisionRow> rows;
-  for (std::int64_t k = 0; k < s.run.steps(); ++k) {
-    stepper.step();
-    tracker.observe(stepper.time(), stepper.contacts(), stepper.state(), rows);
-  }
-  tracker.finish(stepper.state(), rows);
+  const std::vector<CollisionRow> rows = test::collisions_of(s, engine);
   REQUIRE(rows.size() == 1);
   const double k = std::pow(std::numbers::pi / c_tau, 2);
-  const double log_e = std::log(e), zeta = -log_e / std::sqrt(std::numbers::pi * std::numbers::pi + log_e * log_e);
-  const double omega_d = std::sqrt(k / m) * std::sqrt(1.0 - zeta * zeta);
-  const double released =
-      (std::numbers::pi - std::atan(2.0 * zeta * std::sqrt(1.0 - zeta * zeta) / (1.0 - 2.0 * zeta * zeta))) / omega_d;
+  const double released = test::released_pulse(k, m, e).duration;
   return {rows[0], std::numbers::pi * std::sqrt(m / k), released};
 }
 
