@@ -15,6 +15,9 @@ namespace {
 constexpr double kBoxMass = 90000.0;  // 10 x 10 x 1 m at 900 kg/m^3
 
 const char* const kEngines[] = {"native", "box2d", "bullet", "ode"};
+// With MuJoCo, whose contacts are always soft: the cases that hold no rigid impact to its
+// closed form (a load carried through a resting contact, the forcing's path).
+const char* const kAllEngines[] = {"native", "box2d", "bullet", "ode", "mujoco"};
 
 struct Outcome {
   BodyStates state;
@@ -122,7 +125,7 @@ TEST_CASE("cross-engine: a floe pushed against a wall carries the push", "[cross
   const std::string text = test::header_toml(20.0, 0.01, 0.3, 0.3) +
                            test::body_toml({"floe", test::box({5, 5}, 10, 10), {}, 0.0, false, {push, 0.0}}) +
                            test::body_toml({"wall", test::box({11, 5}, 2, 40), {}, 0.0, true});
-  for (const char* engine : kEngines) {
+  for (const char* engine : kAllEngines) {
     if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Outcome o = run(engine, text, 1000);
@@ -131,8 +134,10 @@ TEST_CASE("cross-engine: a floe pushed against a wall carries the push", "[cross
     // over the 10 s mean; ODE's ERP correction likewise.
     CHECK(o.impulse_on_b / 10.0 == Approx(push).epsilon(1e-3));
     // Box2D's resting contact jitters at about 1.2 mm/s (its soft position correction feeds
-    // back into the velocity); the others hold still to round-off.
-    CHECK(std::abs(o.state.velocity[0].x) < (std::string(engine) == "box2d" ? 5e-3 : 1e-6));
+    // back into the velocity), MuJoCo's at 0.034 mm/s (its multi-point collider's points come
+    // and go on the pressed face); the others hold still to round-off.
+    const std::string name = engine;
+    CHECK(std::abs(o.state.velocity[0].x) < (name == "box2d" ? 5e-3 : name == "mujoco" ? 1e-4 : 1e-6));
     CHECK(o.state.position[0].x == Approx(5.0).margin(0.02));  // at the wall, within 2 cm
   }
 }
@@ -147,7 +152,7 @@ TEST_CASE("cross-engine: a floe in a steady current against a fixed iceberg", "[
       "draft = 60.0\nsail_height = 15.0\n";
   const double draft = 900.0 / 1025.0;
   const double drag = 0.5 * 1025.0 * 0.9 * 10.0 * draft * 0.25 + 1025.0 * 5e-4 * 100.0 * 0.25;
-  for (const char* engine : kEngines) {
+  for (const char* engine : kAllEngines) {
     if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Scene s = test::scene_from(text);
@@ -174,7 +179,7 @@ TEST_CASE("cross-engine: Coriolis alone, the inertial circle on every engine", "
       "[environment.drag]\nwater_form = 0.0\nwater_skin = 0.0\nair_form = 0.0\nair_skin = 0.0\n" +
       test::body_toml({"floe", test::box({0, 0}, 10, 10), {0.1, 0.0}});
   const double f = 2.0 * 7.2921e-5 * std::sin(75.0 * M_PI / 180.0), radius = 0.1 / f;
-  for (const char* engine : kEngines) {
+  for (const char* engine : kAllEngines) {
     if (!test::have_engine(engine)) continue;
     INFO(engine);
     const Scene s = test::scene_from(text);
