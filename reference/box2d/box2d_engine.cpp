@@ -16,6 +16,7 @@
 #include <unordered_map>
 
 #include "geometry/polygon.hpp"
+#include "reference/adapter.hpp"
 #include "floedem/run/simulation.hpp"
 #include "scenario/table_reader.hpp"
 
@@ -254,23 +255,22 @@ void Box2dEngine::add_stage_times(std::vector<StageTime>& out) const {
 }
 
 void Box2dEngine::apply_loads(const Loads& loads) {
-  for (const PrescribedMotion& p : loads.prescribed) {
-    bodies_[p.body]->SetLinearVelocity(b2Vec2(static_cast<float>(p.velocity.x), static_cast<float>(p.velocity.y)));
-    bodies_[p.body]->SetAngularVelocity(static_cast<float>(p.angular_velocity));
-  }
-  if (!loads.velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
-    for (std::size_t i = 0; i < bodies_.size(); ++i) {
-      if (bodies_[i]->GetType() != b2_dynamicBody) continue;
-      const b2Vec2 v = bodies_[i]->GetLinearVelocity();
-      const Vec2 turned = loads.velocity_turn[i].apply({v.x, v.y});
-      bodies_[i]->SetLinearVelocity(b2Vec2(static_cast<float>(turned.x), static_cast<float>(turned.y)));
-    }
-  if (loads.any)
-    for (std::size_t i = 0; i < bodies_.size(); ++i) {
-      if (bodies_[i]->GetType() != b2_dynamicBody) continue;
-      bodies_[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(loads.force[i].x), static_cast<float>(loads.force[i].y)), true);
-      bodies_[i]->ApplyTorque(static_cast<float>(loads.torque[i]), true);
-    }
+  const auto b2 = [](Vec2 v) { return b2Vec2(static_cast<float>(v.x), static_cast<float>(v.y)); };
+  reference::hand_loads(
+      loads, bodies_.size(), [&](std::size_t i) { return bodies_[i]->GetType() == b2_dynamicBody; },
+      [&](const PrescribedMotion& p) {
+        bodies_[p.body]->SetLinearVelocity(b2(p.velocity));
+        bodies_[p.body]->SetAngularVelocity(static_cast<float>(p.angular_velocity));
+      },
+      [&](std::size_t i) {
+        const b2Vec2 v = bodies_[i]->GetLinearVelocity();
+        return Vec2{v.x, v.y};
+      },
+      [&](std::size_t i, Vec2 v) { bodies_[i]->SetLinearVelocity(b2(v)); },
+      [&](std::size_t i, Vec2 force, double torque) {
+        bodies_[i]->ApplyForceToCenter(b2(force), true);
+        bodies_[i]->ApplyTorque(static_cast<float>(torque), true);
+      });
 }
 
 void Box2dEngine::publish() {

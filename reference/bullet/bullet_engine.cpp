@@ -26,6 +26,7 @@
 
 #include "contacts/collision_forces.hpp"
 #include "geometry/polygon.hpp"
+#include "reference/adapter.hpp"
 #include "scenario/table_reader.hpp"
 
 namespace floedem {
@@ -200,28 +201,25 @@ EngineInfo BulletEngine::info() const {
 
 void BulletEngine::step(const Loads* loads) {
   before_ = state_;
-  if (loads) {
-    for (const PrescribedMotion& p : loads->prescribed) {
-      // Kinematic bodies: Bullet takes their velocity from the motion state's change.
-      btRigidBody* b = bodies_[p.body].get();
-      btTransform t = b->getWorldTransform();
-      t.setOrigin(t.getOrigin() + btVector3(p.velocity.x, p.velocity.y, 0) * dt_);
-      b->getMotionState()->setWorldTransform(t);
-    }
-    if (!loads->velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
-      for (std::size_t i = 0; i < bodies_.size(); ++i) {
-        if (bodies_[i]->getInvMass() == 0) continue;
-        const btVector3& v = bodies_[i]->getLinearVelocity();
-        const Vec2 turned = loads->velocity_turn[i].apply({v.x(), v.y()});
-        bodies_[i]->setLinearVelocity(btVector3(turned.x, turned.y, 0));
-      }
-    if (loads->any)
-      for (std::size_t i = 0; i < bodies_.size(); ++i) {
-        if (bodies_[i]->getInvMass() == 0) continue;
-        bodies_[i]->applyCentralForce(btVector3(loads->force[i].x, loads->force[i].y, 0));
-        bodies_[i]->applyTorque(btVector3(0, 0, loads->torque[i]));
-      }
-  }
+  if (loads)
+    reference::hand_loads(
+        *loads, bodies_.size(), [&](std::size_t i) { return bodies_[i]->getInvMass() != 0; },
+        [&](const PrescribedMotion& p) {
+          // Kinematic bodies: Bullet takes their velocity from the motion state's change.
+          btRigidBody* b = bodies_[p.body].get();
+          btTransform t = b->getWorldTransform();
+          t.setOrigin(t.getOrigin() + btVector3(p.velocity.x, p.velocity.y, 0) * dt_);
+          b->getMotionState()->setWorldTransform(t);
+        },
+        [&](std::size_t i) {
+          const btVector3& v = bodies_[i]->getLinearVelocity();
+          return Vec2{v.x(), v.y()};
+        },
+        [&](std::size_t i, Vec2 v) { bodies_[i]->setLinearVelocity(btVector3(v.x, v.y, 0)); },
+        [&](std::size_t i, Vec2 force, double torque) {
+          bodies_[i]->applyCentralForce(btVector3(force.x, force.y, 0));
+          bodies_[i]->applyTorque(btVector3(0, 0, torque));
+        });
   world_.stepSimulation(dt_, 0);
   publish();
   collect_contacts();
@@ -288,11 +286,7 @@ void BulletEngine::collect_contacts() {
       r.normal_impulse = dot(on_b, normal);
       r.tangent_impulse = dot(on_b, perp(normal));
       r.separation = pt.getDistance();
-      const auto pv = [&](int i) {
-        return before_.velocity[i] + cross(before_.angular_velocity[i], r.point - before_.position[i]);
-      };
-      r.approach_velocity = dot(pv(r.body_b) - pv(r.body_a), normal);
-      r.kind = r.approach_velocity < -threshold_ ? ContactKind::collision : ContactKind::resting;
+      reference::classify(r, before_, threshold_);
       records_.push_back(r);
     }
   }

@@ -47,6 +47,7 @@
 
 #include "contacts/collision_forces.hpp"
 #include "geometry/polygon.hpp"
+#include "reference/adapter.hpp"
 #include "scenario/table_reader.hpp"
 
 namespace floedem {
@@ -247,7 +248,16 @@ MujocoEngine::MujocoEngine(const Scene& scene)
   model_ = mj_loadXML(name, vfs.get(), error, sizeof error);
   mj_deleteVFS(vfs.get());
   mj_freeLastXML();  // MuJoCo keeps the parsed text for mj_saveLastXML, a process-wide copy
-  if (!model_) throw std::runtime_error(std::string("MuJoCo could not build the scene's model: ") + error);
+  if (!model_) {
+    // MuJoCo 2.2 allocates its data for the whole scene when it compiles the model: its
+    // constraint arrays for max_contacts (some as their square) and the solver's stack.
+    if (std::strstr(error, "mjData"))
+      throw std::runtime_error("MuJoCo could not allocate its arrays for " + std::to_string(n) + " bodies and " +
+                               std::to_string(settings_.max_contacts > 0 ? settings_.max_contacts : 6 * static_cast<int>(n) + 100) +
+                               " contacts (it sizes them for the whole scene at the start): lower [engine.mujoco] "
+                               "max_contacts, or run a smaller scene");
+    throw std::runtime_error(std::string("MuJoCo could not build the scene's model: ") + error);
+  }
   mjOption& o = model_->opt;
   o.timestep = h_;
   mju_zero3(o.gravity);
@@ -426,12 +436,7 @@ void MujocoEngine::collect_contacts() {
     r.normal_impulse = dot(on_b, r.normal);
     r.tangent_impulse = dot(on_b, perp(r.normal));
     r.separation = k.dist;
-    const auto pv = [&](std::int32_t i) {
-      const std::size_t u = static_cast<std::size_t>(i);
-      return before_.velocity[u] + cross(before_.angular_velocity[u], r.point - before_.position[u]);
-    };
-    r.approach_velocity = dot(pv(r.body_b) - pv(r.body_a), r.normal);
-    r.kind = r.approach_velocity < -contact_.collision_threshold ? ContactKind::collision : ContactKind::resting;
+    reference::classify(r, before_, contact_.collision_threshold);
     records_.push_back(r);
   }
 }
@@ -442,23 +447,20 @@ void MujocoEngine::step(const Loads* loads) {
   motion_.clear();
   mjData* d = data_;
   mju_zero(d->qfrc_applied, model_->nv);
-  if (loads) {
-    motion_ = loads->prescribed;
-    if (!loads->velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
-      for (std::size_t i = 0; i < dof_.size(); ++i) {
-        if (dof_[i] < 0 || prescribed_[i]) continue;
-        const Vec2 turned = loads->velocity_turn[i].apply({d->qvel[dof_[i]], d->qvel[dof_[i] + 1]});
-        d->qvel[dof_[i]] = turned.x;
-        d->qvel[dof_[i] + 1] = turned.y;
-      }
-    if (loads->any)
-      for (std::size_t i = 0; i < dof_.size(); ++i) {
-        if (dof_[i] < 0 || prescribed_[i]) continue;
-        d->qfrc_applied[dof_[i]] = loads->force[i].x;
-        d->qfrc_applied[dof_[i] + 1] = loads->force[i].y;
-        d->qfrc_applied[dof_[i] + 2] = loads->torque[i];
-      }
-  }
+  if (loads)
+    reference::hand_loads(
+        *loads, dof_.size(), [&](std::size_t i) { return dof_[i] >= 0 && !prescribed_[i]; },
+        [&](const PrescribedMotion& p) { motion_.push_back(p); },  // set on each substep
+        [&](std::size_t i) { return Vec2{d->qvel[dof_[i]], d->qvel[dof_[i] + 1]}; },
+        [&](std::size_t i, Vec2 v) {
+          d->qvel[dof_[i]] = v.x;
+          d->qvel[dof_[i] + 1] = v.y;
+        },
+        [&](std::size_t i, Vec2 force, double torque) {
+          d->qfrc_applied[dof_[i]] = force.x;
+          d->qfrc_applied[dof_[i] + 1] = force.y;
+          d->qfrc_applied[dof_[i] + 2] = torque;
+        });
   std::string warning;
   warnings = &warning;
   try {

@@ -27,6 +27,7 @@
 #include "scenario/table_reader.hpp"
 #include "collision/broad_phase.hpp"
 #include "collision/part_set.hpp"
+#include "reference/adapter.hpp"
 
 namespace floedem {
 
@@ -225,9 +226,7 @@ void OdeEngine::step(const Loads* loads) {
       r.point = p.point;
       r.normal = m.normal;
       r.separation = p.separation;
-      const auto pv = [&](std::int32_t i) { return state_.velocity[i] + cross(state_.angular_velocity[i], p.point - state_.position[i]); };
-      r.approach_velocity = dot(pv(b) - pv(a), m.normal);
-      r.kind = r.approach_velocity < -contact_.collision_threshold ? ContactKind::collision : ContactKind::resting;
+      reference::classify(r, state_, contact_.collision_threshold);
       pending_.push_back({j, r, b_is_body1});
     }
   }
@@ -235,25 +234,22 @@ void OdeEngine::step(const Loads* loads) {
     feedback_.push_back(dJointFeedback{});
     dJointSetFeedback(p.joint, &feedback_.back());
   }
-  if (loads) {
-    for (const PrescribedMotion& p : loads->prescribed) {
-      dBodySetLinearVel(bodies_[p.body], p.velocity.x, p.velocity.y, 0.0);
-      dBodySetAngularVel(bodies_[p.body], 0.0, 0.0, p.angular_velocity);
-    }
-    if (!loads->velocity_turn.empty())  // Coriolis alone: the exact turn instead of a force
-      for (std::size_t i = 0; i < bodies_.size(); ++i) {
-        if (!bodies_[i] || dBodyIsKinematic(bodies_[i])) continue;
-        const dReal* v = dBodyGetLinearVel(bodies_[i]);
-        const Vec2 turned = loads->velocity_turn[i].apply({v[0], v[1]});
-        dBodySetLinearVel(bodies_[i], turned.x, turned.y, 0.0);
-      }
-    if (loads->any)
-      for (std::size_t i = 0; i < bodies_.size(); ++i) {
-        if (!bodies_[i] || dBodyIsKinematic(bodies_[i])) continue;
-        dBodyAddForce(bodies_[i], loads->force[i].x, loads->force[i].y, 0.0);
-        dBodyAddTorque(bodies_[i], 0.0, 0.0, loads->torque[i]);
-      }
-  }
+  if (loads)
+    reference::hand_loads(
+        *loads, bodies_.size(), [&](std::size_t i) { return bodies_[i] && !dBodyIsKinematic(bodies_[i]); },
+        [&](const PrescribedMotion& p) {
+          dBodySetLinearVel(bodies_[p.body], p.velocity.x, p.velocity.y, 0.0);
+          dBodySetAngularVel(bodies_[p.body], 0.0, 0.0, p.angular_velocity);
+        },
+        [&](std::size_t i) {
+          const dReal* v = dBodyGetLinearVel(bodies_[i]);
+          return Vec2{v[0], v[1]};
+        },
+        [&](std::size_t i, Vec2 v) { dBodySetLinearVel(bodies_[i], v.x, v.y, 0.0); },
+        [&](std::size_t i, Vec2 force, double torque) {
+          dBodyAddForce(bodies_[i], force.x, force.y, 0.0);
+          dBodyAddTorque(bodies_[i], 0.0, 0.0, torque);
+        });
   // QuickStep shuffles its constraint order with ODE's one global random generator, so a
   // second world in the same process (a test, a sweep) would continue the first one's stream
   // and give another result. Each engine keeps its own seed across steps instead: a run is
