@@ -784,6 +784,18 @@ void Recorder::write_polygons(const std::string& group, const std::string& name,
   }
 }
 
+void Recorder::discard() {
+  if (impl_ && !impl_->closed) {
+    try {
+      impl_->file.close();
+    } catch (...) {
+    }
+    impl_->closed = true;
+  }
+  std::error_code ec;
+  std::filesystem::remove(partial_path_, ec);
+}
+
 void Recorder::finish(const std::vector<std::pair<std::string, double>>& summary) {
   Impl& d = *impl_;
   drop_stop_checkpoint();  // a run stopped and continued past its last regular checkpoint holds one

@@ -68,6 +68,9 @@ class Recorder {
   /// Polygons as `name_vertices` [V, 2] and `name_offsets` [P + 1] in a group (created when
   /// missing): the layout of /bodies/polygon_vertices and polygon_offsets.
   void write_polygons(const std::string& group, const std::string& name, const std::vector<std::vector<Vec2>>& polygons);
+  /// Closes and removes the .partial file: for bad input found before the first step was
+  /// made, where there is nothing a run could continue.
+  void discard();
   /// Writes what is buffered, marks the file complete, closes it and renames it to `path`.
   void finish(const std::vector<std::pair<std::string, double>>& summary);
 

@@ -308,6 +308,7 @@ class SceneRun {
     return true;
   }
   const std::string& partial_path() const { return recorder_->partial_path(); }
+  void discard_output() { recorder_->discard(); }
 
  private:
   /// The state after step k into checkpoint_bytes_, with `count` regular checkpoints written
@@ -364,7 +365,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const std::int64_t kill_at = test_signal_step("FLOEDEM_TEST_KILL_AT_STEP");
   const std::int64_t term_at = test_signal_step("FLOEDEM_TEST_TERM_AT_STEP");
   for (std::int64_t k = first; k <= steps; ++k) {
-    run.step(k);
+    try {
+      run.step(k);
+    } catch (const InputError&) {
+      // Bad input that only the first step can find (a forcing grid's fill value or edge under
+      // a body's starting place, read where the forcing reads it): refused like any other bad
+      // input, with nothing written. Found later, the rows so far stay in the .partial file.
+      if (k == 1) run.discard_output();
+      throw;
+    }
     progress.update(k, steps);
     if (k == kill_at) std::raise(SIGKILL);
     if (k == term_at) std::raise(SIGTERM);

@@ -19,6 +19,7 @@
 #include "run/stepper.hpp"
 #include "floedem/scenario/scenario.hpp"
 #include "floedem/scene/input_error.hpp"
+#include "floedem/run/simulation.hpp"
 #include "support.hpp"
 
 using namespace floedem;
@@ -513,6 +514,13 @@ TEST_CASE("bad gridded forcing is refused with the file, the variable and what i
   INFO(message);
   CHECK(message.find("hole.nc") != std::string::npos);
   CHECK(message.find("fill value") != std::string::npos);
+  // The same through a run: refused at its first step with nothing written, neither the file
+  // nor a .partial that would look like a run to continue.
+  RunOptions o;
+  o.output = (dir / "hole.h5").string();
+  CHECK_THROWS_AS(run_scene(s, o), InputError);
+  CHECK_FALSE(std::filesystem::exists(o.output));
+  CHECK_FALSE(std::filesystem::exists(o.output + ".partial"));
 }
 
 TEST_CASE("a gridded current with a depth axis feeds each keel layer the current at its depth",
