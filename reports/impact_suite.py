@@ -5,7 +5,7 @@ Two parts, both from the four scenarios of scenarios/impacts/:
 - impulses and restitution: every engine with its rigid (impulse) contact, e from 0 to 0.9, the
   10 m floes as written; the closed form J = (1 + e) m_eff u for the head-on cases;
 - collision durations: swept over floe mass (99 kg to 9.9e9 kg) and approach speed (0.05 to
-  3 m/s) on native (duration estimated from the impulse, tau = C_tau sqrt(m_eff)) and on ODE and
+  3 m/s) on native (duration estimated from the impulse, tau = C_tau sqrt(m_eff)) and on ODE, MuJoCo and
   Bullet with compliant contacts (duration measured); the exponent of tau against m_eff per
   engine, the compliant durations against the closed-form release time t_c, native's estimate
   against them as ratios, and the sensitivity of the peak force to e and C_tau.
@@ -215,7 +215,7 @@ def summarize(runs, rel_to, fig_dir, quick):
            f"The cases scaled from 1 m to 1 km floes (thickness 0.11 L^(2/3): {min(x['mass'] for x in dur):.3g} to "
            f"{max(x['mass'] for x in dur):.3g} kg) and approach speeds 0.05 to 3 m/s, dt = tau / {STEPS_PER_PULSE}, "
            f"C_tau = {C_TAU:g} s kg^-1/2 (k = {(math.pi / C_TAU) ** 2:.3g} N/m), e = 0.1. Native estimates the "
-           "duration from the impulse, tau = C_tau sqrt(m_eff); ODE and Bullet measure it on a compliant "
+           "duration from the impulse, tau = C_tau sqrt(m_eff); ODE, Bullet and MuJoCo (10 substeps a step) measure it on a compliant "
            "spring-dashpot with the same k, which lets go at t_c = 0.741 pi sqrt(m_eff / k) for e = 0.1 "
            "(docs/model.md 4).", "", "![duration against effective mass](fig/impact_durations.png)", "",
            "| engine | exponent of tau on m_eff | m_eff range (kg) | measured / t_c (mean, range) | cases |",
