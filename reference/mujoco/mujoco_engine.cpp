@@ -162,12 +162,12 @@ std::string MujocoEngine::model_text(const Scene& scene) const {
   x << "<mujoco model=\"floedem\">\n"
        "<compiler inertiafromgeom=\"false\" angle=\"radian\"/>\n";
   const int n = static_cast<int>(scene.bodies.size());
-  const int nconmax = settings_.max_contacts > 0 ? settings_.max_contacts : 6 * n + 100;
+  const int nconmax = settings_.max_contacts > 0 ? settings_.max_contacts : 2 * n + 100;
   const int rows = (settings_.cone == "elliptic" ? 3 : 4) * nconmax;
   const int nv = 3 * n;
-  // The stack holds the solver's work arrays: Newton's dense nv x nv Hessian and a few
-  // vectors per row and per dof.
-  const long stack = 2L * nv * nv + 40L * rows + 40L * nv + 100000;
+  // The stack holds the solver's work arrays: Newton's dense nv x nv Hessian, its dense
+  // product of the rows' Jacobian (rows x nv) and a few vectors per row and per dof.
+  const long stack = 2L * nv * nv + 2L * rows * nv + 40L * rows + 40L * nv + 100000;
   x << "<size nconmax=\"" << nconmax << "\" njmax=\"" << rows << "\" nstack=\"" << stack << "\"/>\n<asset>\n";
   for (int i = 0; i < n; ++i) {
     const BodySpec& b = scene.bodies[static_cast<std::size_t>(i)];
@@ -253,7 +253,7 @@ MujocoEngine::MujocoEngine(const Scene& scene)
     // constraint arrays for max_contacts (some as their square) and the solver's stack.
     if (std::strstr(error, "mjData"))
       throw std::runtime_error("MuJoCo could not allocate its arrays for " + std::to_string(n) + " bodies and " +
-                               std::to_string(settings_.max_contacts > 0 ? settings_.max_contacts : 6 * static_cast<int>(n) + 100) +
+                               std::to_string(settings_.max_contacts > 0 ? settings_.max_contacts : 2 * static_cast<int>(n) + 100) +
                                " contacts (it sizes them for the whole scene at the start): lower [engine.mujoco] "
                                "max_contacts, or run a smaller scene");
     throw std::runtime_error(std::string("MuJoCo could not build the scene's model: ") + error);
