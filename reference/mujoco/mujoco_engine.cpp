@@ -146,12 +146,9 @@ class MujocoEngine final : public Engine {
   std::vector<PrescribedMotion> motion_;
   BodyStates state_, before_;
   std::vector<ContactRecord> records_;
-  struct PairGroup {
-    std::int32_t a, b;
-    int count;
-    Vec2 middle;
-  };
   std::vector<std::int32_t> order_;
+  std::vector<double> towed_qpos_;      ///< the towed bodies' joints before a substep's integration
+  int contacts_ = 0;                    ///< MuJoCo's nconmax
   std::uint64_t contact_rows_ = 0, solver_iterations_ = 0, substeps_made_ = 0;
   double shortest_pulse_ = 0.0;
   std::string warning_;
@@ -162,13 +159,12 @@ std::string MujocoEngine::model_text(const Scene& scene) const {
   x << "<mujoco model=\"floedem\">\n"
        "<compiler inertiafromgeom=\"false\" angle=\"radian\"/>\n";
   const int n = static_cast<int>(scene.bodies.size());
-  const int nconmax = settings_.max_contacts > 0 ? settings_.max_contacts : 2 * n + 100;
-  const int rows = (settings_.cone == "elliptic" ? 3 : 4) * nconmax;
+  const int rows = (settings_.cone == "elliptic" ? 3 : 4) * contacts_;
   const int nv = 3 * n;
   // The stack holds the solver's work arrays: Newton's dense nv x nv Hessian, its dense
   // product of the rows' Jacobian (rows x nv) and a few vectors per row and per dof.
   const long stack = 2L * nv * nv + 2L * rows * nv + 40L * rows + 40L * nv + 100000;
-  x << "<size nconmax=\"" << nconmax << "\" njmax=\"" << rows << "\" nstack=\"" << stack << "\"/>\n<asset>\n";
+  x << "<size nconmax=\"" << contacts_ << "\" njmax=\"" << rows << "\" nstack=\"" << stack << "\"/>\n<asset>\n";
   for (int i = 0; i < n; ++i) {
     const BodySpec& b = scene.bodies[static_cast<std::size_t>(i)];
     for (std::size_t k = 0; k < b.local_parts.size(); ++k) {
@@ -228,6 +224,7 @@ MujocoEngine::MujocoEngine(const Scene& scene)
     }
   }
   prescribed_mass_ = 1e6 * std::max(heaviest, 1.0);
+  contacts_ = settings_.max_contacts > 0 ? settings_.max_contacts : 2 * static_cast<int>(n) + 100;
   // The shortest pulse: pi sqrt(m_eff / k) with m_eff at most the lightest free body's mass
   // (half of it head-on against its like; a lever arm lowers it further, which the margin of
   // 10 substeps a pulse covers).
@@ -253,7 +250,7 @@ MujocoEngine::MujocoEngine(const Scene& scene)
     // constraint arrays for max_contacts (some as their square) and the solver's stack.
     if (std::strstr(error, "mjData"))
       throw std::runtime_error("MuJoCo could not allocate its arrays for " + std::to_string(n) + " bodies and " +
-                               std::to_string(settings_.max_contacts > 0 ? settings_.max_contacts : 2 * static_cast<int>(n) + 100) +
+                               std::to_string(contacts_) +
                                " contacts (it sizes them for the whole scene at the start): lower [engine.mujoco] "
                                "max_contacts, or run a smaller scene");
     throw std::runtime_error(std::string("MuJoCo could not build the scene's model: ") + error);
@@ -391,15 +388,15 @@ void MujocoEngine::substep() {
   mj_transmission(model_, d);
   mj_projectConstraint(model_, d);
   mj_forwardSkip(model_, d, mjSTAGE_POS, 1);
-  std::vector<double> qpos_before;
-  for (const PrescribedMotion& p : motion_) qpos_before.insert(qpos_before.end(), d->qpos + dof_[p.body], d->qpos + dof_[p.body] + 3);
+  towed_qpos_.clear();
+  for (const PrescribedMotion& p : motion_) towed_qpos_.insert(towed_qpos_.end(), d->qpos + dof_[p.body], d->qpos + dof_[p.body] + 3);
   collect_contacts();
   mj_Euler(model_, d);
   for (std::size_t k = 0; k < motion_.size(); ++k) {
     const PrescribedMotion& p = motion_[k];
-    d->qpos[dof_[p.body]] = qpos_before[3 * k] + h_ * p.velocity.x;
-    d->qpos[dof_[p.body] + 1] = qpos_before[3 * k + 1] + h_ * p.velocity.y;
-    d->qpos[dof_[p.body] + 2] = qpos_before[3 * k + 2] + h_ * p.angular_velocity;
+    d->qpos[dof_[p.body]] = towed_qpos_[3 * k] + h_ * p.velocity.x;
+    d->qpos[dof_[p.body] + 1] = towed_qpos_[3 * k + 1] + h_ * p.velocity.y;
+    d->qpos[dof_[p.body] + 2] = towed_qpos_[3 * k + 2] + h_ * p.angular_velocity;
   }
   contact_rows_ += static_cast<std::uint64_t>(d->nefc);
   solver_iterations_ += static_cast<std::uint64_t>(d->solver_iter);
