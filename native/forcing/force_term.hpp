@@ -21,6 +21,7 @@ namespace floedem {
 class CoriolisField;
 class DistributedDrag;
 class FlowGrid;
+struct TowLine;
 
 /// What varies over the scene's plane, each null where the scene has none: the gridded wind and
 /// current (flow_grid.hpp), built and prepared once a step by Forcing, and the Coriolis
@@ -136,6 +137,9 @@ class ForceTerm {
   /// Hands the term the scene's gridded fields (once, before the first step); a term that
   /// reads none ignores them.
   virtual void attach_fields(const FlowFields&) {}
+  /// Hands the term the run's tow line (towing/tow.hpp: the tug of mode tug, the rope's
+  /// parting), which the run's TowMonitor moves; a term that reads none ignores it.
+  virtual void attach_tow(const TowLine&) {}
   /// The term as a distributed drag (drag.hpp), which Forcing may hand a shared pass over the
   /// floes; nullptr for every other term.
   virtual DistributedDrag* distributed_drag() { return nullptr; }

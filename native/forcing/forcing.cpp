@@ -74,6 +74,10 @@ std::array<double, 3> solve3(const std::array<double, 9>& a, const std::array<do
 }
 }  // namespace
 
+void Forcing::attach_tow(const TowLine& line) {
+  for (const auto& term : terms_) term->attach_tow(line);
+}
+
 std::array<double, 3> Forcing::environment_force(std::size_t i) const {
   std::array<double, 3> q = sums_.q[i];
   if (sums_.any_rotation && scene_.bodies[i].prescribed) {

@@ -49,6 +49,8 @@ class Forcing {
   /// Checkpoint: what the next step reads of the last (the accelerations of the free bodies).
   void save(StateWriter& out) const;
   void restore(StateReader& in);
+  /// Hands the terms the run's tow line (ForceTerm::attach_tow), before the first step.
+  void attach_tow(const TowLine& line);
   /// The generalised force of all terms on prescribed (towed) body i over the last evaluated
   /// step, Coriolis included (-m f k x v at its prescribed velocity). Towing reads it.
   std::array<double, 3> environment_force(std::size_t i) const;

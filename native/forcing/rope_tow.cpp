@@ -1,9 +1,12 @@
-// Rope towing (docs/model.md 6): an elastic rope from a tug moving on a prescribed path to a point
-// on the iceberg. Tension T = k (L - L0) + c dL/dt when taut (L > L0) and T > 0, else 0 (a
-// rope cannot push); it acts along the rope at the attachment point (force and torque).
-// The rope's stiffness and damping along its direction enter the Jacobian (stiffness as
-// dt k, since the stretch grows by dt times the velocity), so that a stiff rope stays stable.
+// Rope towing (docs/model.md 6, docs/towing.md): an elastic rope from a tug to a point on the
+// iceberg; the tug moves on a prescribed path (mode rope) or pulls with what it has (mode tug,
+// towing/tow.cpp). Tension T = k (L - L0) + c dL/dt when taut (L > L0) and T > 0, else 0 (a
+// rope cannot push), and 0 once the rope has parted; it acts along the rope at the attachment
+// point (force and torque). The rope's stiffness and damping along its direction enter the
+// Jacobian (stiffness as dt k, since the stretch grows by dt times the velocity), so that a
+// stiff rope stays stable.
 #include <cmath>
+#include <stdexcept>
 
 #include "forcing/force_term.hpp"
 #include "towing/tow.hpp"
@@ -14,10 +17,20 @@ namespace {
 
 class RopeTow final : public ForceTerm {
  public:
-  explicit RopeTow(const Scene& scene) : tow_(scene.tow), dt_(scene.run.dt) {}
+  explicit RopeTow(const Scene& scene)
+      : tow_(scene.tow),
+        water_(scene.has_environment ? &scene.environment : nullptr),
+        dt_(scene.run.dt),
+        own_(scene.tow),
+        line_(&own_) {}
   std::string_view name() const override { return "rope_tow"; }
+  void attach_tow(const TowLine& line) override { line_ = &line; }
   void add(const BodyStatesView& s, double time, ForceSums& sums) const override {
-    const RopeState r = rope_state(tow_, s, time);
+    // Mode tug's tug moves with the run (TowMonitor): a term that was never handed the run's
+    // line would pull from where the tug started, for ever.
+    if (tow_.mode == TowSpec::Mode::tug && line_ == &own_)
+      throw std::logic_error("rope_tow: mode tug needs the run's tow line (Forcing::attach_tow)");
+    const RopeState r = rope_state(tow_, *line_, water_, s, time);
     if (r.tension <= 0.0) return;
     const double k = tow_.damping + dt_ * tow_.stiffness;
     // Force on the body along e; dF/du with u = tug velocity - point velocity: k e e^T.
@@ -28,13 +41,16 @@ class RopeTow final : public ForceTerm {
 
  private:
   const TowSpec& tow_;
+  const EnvironmentSpec* water_;
   double dt_;
+  TowLine own_;  ///< mode rope without a run (the tug on its path, the rope whole)
+  const TowLine* line_;
 };
 
 }  // namespace
 
 std::unique_ptr<ForceTerm> build_rope_tow(const Scene& scene) {
-  if (scene.tow.mode != TowSpec::Mode::rope) return nullptr;
+  if (!scene.tow.has_rope()) return nullptr;
   return std::make_unique<RopeTow>(scene);
 }
 

@@ -200,9 +200,15 @@ struct Recorder::Impl {
   ContactOutput contact_output = ContactOutput::all;
   // Towing.
   bool tow = false;
+  bool rope = false, tug = false;  // the tow's rope (modes rope, tug) and its tug (mode tug)
+  void set_tow(const TowSpec& spec) {
+    tow = spec.mode != TowSpec::Mode::none;
+    rope = spec.has_rope();
+    tug = spec.mode == TowSpec::Mode::tug;
+  }
   bool crushing = false;  // contact.force_model = pressure_area: two more collision columns
-  Series tow_time, tow_force, tow_force_mean, tow_ice_mean, tow_tug;
-  std::vector<double> w_time, w_force, w_mean, w_ice, w_tug;
+  Series tow_time, tow_force, tow_force_mean, tow_ice_mean, tow_tug, tow_tension, tow_tug_velocity;
+  std::vector<double> w_time, w_force, w_mean, w_ice, w_tug, w_tension, w_tug_velocity;
   // Contact loads.
   Series load_time, load_force;
   std::vector<double> l_time, l_force;
@@ -268,6 +274,8 @@ struct Recorder::Impl {
       t.push_back({&tow_force_mean, "/tow/force_mean", f64, {2}, kt, &R::tow});
       t.push_back({&tow_ice_mean, "/tow/ice_force_mean", f64, {2}, kt, &R::tow});
       t.push_back({&tow_tug, "/tow/tug_position", f64, {2}, kt, &R::tow});
+      if (rope) t.push_back({&tow_tension, "/tow/tension_max", f64, {}, kt, &R::tow});
+      if (tug) t.push_back({&tow_tug_velocity, "/tow/tug_velocity", f64, {2}, kt, &R::tow});
     }
     if (!scene.output.load_bodies.empty()) {
       const hsize_t nb = scene.output.load_bodies.size();
@@ -296,7 +304,10 @@ struct Recorder::Impl {
       tow_force_mean.append(w_mean.data(), n);
       tow_ice_mean.append(w_ice.data(), n);
       tow_tug.append(w_tug.data(), n);
-      w_time.clear(); w_force.clear(); w_mean.clear(); w_ice.clear(); w_tug.clear();
+      if (rope) tow_tension.append(w_tension.data(), n);
+      if (tug) tow_tug_velocity.append(w_tug_velocity.data(), n);
+      w_time.clear(); w_force.clear(); w_mean.clear(); w_ice.clear(); w_tug.clear(); w_tension.clear();
+      w_tug_velocity.clear();
     }
     if (!l_time.empty()) {
       load_time.append(l_time.data(), l_time.size());
@@ -434,10 +445,10 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
                      : "min(-0.3, 0.2 h - 0.5), h in m (ISO 19906)",
                  d.fixed_strings);
     }
-    if (scene.tow.mode != TowSpec::Mode::none) {
-      d.tow = true;
+    d.set_tow(scene.tow);
+    if (d.tow) {
       H5::Group tow = d.file.createGroup("/tow");
-      write_text(tow, "mode", scene.tow.mode == TowSpec::Mode::velocity ? "velocity" : "rope", d.fixed_strings);
+      write_text(tow, "mode", scene.tow.mode_name(), d.fixed_strings);
       write_text(tow, "body", scene.bodies[scene.tow.body].name, d.fixed_strings);
     }
     if (!scene.output.load_bodies.empty()) {
@@ -516,7 +527,7 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& r
     d.bodies = scene.bodies.size();
     d.frame_chunk = frame_chunk_of(d.bodies);
     d.contact_output = scene.output.contacts;
-    d.tow = scene.tow.mode != TowSpec::Mode::none;
+    d.set_tow(scene.tow);
     d.crushing = scene.contact.force_model == ContactSettings::ForceModel::pressure_area;
     if (scene.geo.present) d.geo = std::make_unique<GeoProjection>(scene.geo);
     for (const Impl::Table& t : d.tables(scene)) {
@@ -600,7 +611,7 @@ std::int64_t Recorder::check_tables(const std::string& file, const Scene& scene,
     layout.bodies = scene.bodies.size();
     layout.frame_chunk = frame_chunk_of(layout.bodies);
     layout.contact_output = scene.output.contacts;
-    layout.tow = scene.tow.mode != TowSpec::Mode::none;
+    layout.set_tow(scene.tow);
     for (const Impl::Table& t : layout.tables(scene)) {
       std::vector<std::int64_t> shape{-1};
       for (const hsize_t d : t.row_shape) shape.push_back(static_cast<std::int64_t>(d));
@@ -618,7 +629,7 @@ std::int64_t Recorder::check_tables(const std::string& file, const Scene& scene,
 
 void Recorder::check_space(const Scene& scene) const {
   // The frames' size is known before the run: 6 doubles per body and frame (position, angle,
-  // velocity, angular velocity; 8 with a geographic scene's longitude and latitude), plus /tow's 9 per row and /loads' 1 + 2 per body per row. A
+  // velocity, angular velocity; 8 with a geographic scene's longitude and latitude), plus /tow's 9 per row (12 with a tug) and /loads' 1 + 2 per body per row. A
   // disk too small for them is told now, not hours into the run (contact rows depend on the run
   // and are not counted).
   const double steps = static_cast<double>(scene.run.steps());
@@ -626,7 +637,7 @@ void Recorder::check_space(const Scene& scene) const {
   const double tow_rows = scene.tow.mode == TowSpec::Mode::none ? 0.0 : steps / scene.tow_every() + 2.0;
   const double load_rows = scene.output.load_bodies.empty() ? 0.0 : steps / scene.load_every() + 2.0;
   const double bytes =
-      8.0 * (frames * ((scene.geo.present ? 8.0 : 6.0) * static_cast<double>(scene.bodies.size()) + 1.0) + 9.0 * tow_rows +
+      8.0 * (frames * ((scene.geo.present ? 8.0 : 6.0) * static_cast<double>(scene.bodies.size()) + 1.0) + 12.0 * tow_rows +
              load_rows * (1.0 + 2.0 * static_cast<double>(scene.output.load_bodies.size())));
   const std::filesystem::path dir = std::filesystem::absolute(path_).parent_path();
   struct statvfs fs {};
@@ -739,6 +750,8 @@ void Recorder::write_tow(double time, const TowFrame& f) {
   d.w_mean.insert(d.w_mean.end(), {f.force_mean.x, f.force_mean.y});
   d.w_ice.insert(d.w_ice.end(), {f.ice_force_mean.x, f.ice_force_mean.y});
   d.w_tug.insert(d.w_tug.end(), {f.tug_position.x, f.tug_position.y});
+  if (d.rope) d.w_tension.push_back(f.tension_max);
+  if (d.tug) d.w_tug_velocity.insert(d.w_tug_velocity.end(), {f.tug_velocity.x, f.tug_velocity.y});
   if (d.w_time.size() >= 4096) d.flush();
 }
 

@@ -47,7 +47,30 @@ std::string force_text(Vec2 f) {
   return buf;
 }
 
+/// The root's attribute `name` (NaN when absent).
+double root_number(H5::H5File& f, const std::string& name) {
+  if (!f.attrExists(name)) return std::nan("");
+  double v = 0.0;
+  H5::Attribute a = f.openAttribute(name);
+  a.read(H5::PredType::NATIVE_DOUBLE, &v);
+  return v;
+}
+
 }  // namespace
+
+std::vector<std::pair<std::string, double>> TowOutcome::attributes() const {
+  return {{"tow_direction_x", direction.x},
+          {"tow_direction_y", direction.y},
+          {"tow_distance", distance},
+          {"tow_cross_track", cross_track},
+          {"tow_speed_made_good", speed_made_good},
+          {"tow_stall_speed", stall_speed},
+          {"tow_stalled_time", stalled_time},
+          {"tow_parted", parted ? 1.0 : 0.0},
+          {"tow_parted_at", parted_at},
+          {"tow_tension_max", tension_max},
+          {"tow_tension_p99", tension_p99}};
+}
 
 RunHeadline read_run_headline(const std::string& path) {
   H5::Exception::dontPrint();
@@ -80,6 +103,21 @@ RunHeadline read_run_headline(const std::string& path) {
         a.read(a.getStrType(), body);
       }
       h.tow = RunHeadline::Tow{body, weighted_mean(force, 1, 0, w), weighted_mean(ice, 1, 0, w)};
+      step = "read the summary's tow outcome";
+      if (f.attrExists("summary_tow_distance")) {
+        TowOutcome o;
+        o.direction = {root_number(f, "summary_tow_direction_x"), root_number(f, "summary_tow_direction_y")};
+        o.distance = root_number(f, "summary_tow_distance");
+        o.cross_track = root_number(f, "summary_tow_cross_track");
+        o.speed_made_good = root_number(f, "summary_tow_speed_made_good");
+        o.stall_speed = root_number(f, "summary_tow_stall_speed");
+        o.stalled_time = root_number(f, "summary_tow_stalled_time");
+        o.parted = root_number(f, "summary_tow_parted") == 1.0;
+        o.parted_at = root_number(f, "summary_tow_parted_at");
+        o.tension_max = root_number(f, "summary_tow_tension_max");
+        o.tension_p99 = root_number(f, "summary_tow_tension_p99");
+        h.tow_outcome = o;
+      }
     }
     if (f.nameExists("/loads")) {
       step = "read /loads";
@@ -120,6 +158,25 @@ std::string format_run_headline(const RunHeadline& h) {
   if (h.tow) {
     out += "  towing      " + std::string(window) + " (" + h.tow->body + "): force " + force_text(h.tow->force) + "\n";
     out += "              of which ice " + force_text(h.tow->ice_force) + "\n";
+  }
+  if (h.tow_outcome) {
+    const TowOutcome& o = *h.tow_outcome;
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "  made good   %.4g m/s: %.6g m along (%.3g, %.3g), %.6g m across; stalled %.6g s (below %.3g m/s)\n",
+                  o.speed_made_good, o.distance, o.direction.x, o.direction.y, o.cross_track, o.stalled_time,
+                  o.stall_speed);
+    out += buf;
+    if (o.tension_max > 0.0 || o.parted) {
+      std::snprintf(buf, sizeof buf, "  rope        tension %.4g N largest, %.4g N p99; %s\n", o.tension_max,
+                    o.tension_p99, o.parted ? "parted" : "held");
+      out += buf;
+      if (o.parted) {
+        out.pop_back();
+        std::snprintf(buf, sizeof buf, " at t = %.6g s\n", o.parted_at);
+        out += buf;
+      }
+    }
   }
   for (const RunHeadline::Load& l : h.loads)
     out += "  load        " + l.body + ", " + window + ": " + force_text(l.force) + "\n";

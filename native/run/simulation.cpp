@@ -255,7 +255,7 @@ class SceneRun {
     summary.contact_rows = recorder.contact_rows();
     summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     recorder.update_engine_info(stepper_.engine().info());
-    recorder.finish({{"steps", static_cast<double>(summary.steps)},
+    std::vector<std::pair<std::string, double>> attributes{{"steps", static_cast<double>(summary.steps)},
                      {"kinetic_energy_start", summary.kinetic_energy_start},
                      {"kinetic_energy_end", summary.kinetic_energy_end},
                      {"collision_impulses", static_cast<double>(summary.collision_impulses)},
@@ -269,7 +269,12 @@ class SceneRun {
                      {"work_of_loads", summary.work_of_loads},
                      {"work_of_paths", summary.work_of_paths},
                      {"contact_work", summary.contact_work},
-                     {"max_relative_energy_gain", summary.max_relative_energy_gain}});
+                     {"max_relative_energy_gain", summary.max_relative_energy_gain}};
+    if (tow_.active()) {
+      const TowOutcome outcome = tow_.outcome(state, t_end);
+      for (auto& a : outcome.attributes()) attributes.push_back(std::move(a));
+    }
+    recorder.finish(attributes);
     // No wall time in the file: two runs of one scene give bit-identical files.
     summary.headline = read_run_headline(options_.output);
     return summary;

@@ -49,6 +49,7 @@ std::vector<std::uint8_t> touching_at_start(const Scene& scene) {
 Stepper::Stepper(const Scene& scene, const std::string& engine)
     : scene_(scene), dt_(scene.run.dt), engine_(make_engine(engine, scene)), forcing_(scene), tow_(scene) {
   if (!forcing_.empty()) touching_ = touching_at_start(scene);
+  forcing_.attach_tow(tow_.line());
 }
 
 void Stepper::frame_state(BodyStates& out) const {
@@ -68,7 +69,7 @@ void Stepper::step() {
   });
   engine_->step(loads_);
   if (tow_.active())
-    stages_.time(kTowing, [&] { tow_.after_step(engine_->contacts(), forcing_.environment_force(scene_.tow.body)); });
+    stages_.time(kTowing, [&] { tow_.after_step(engine_->state(), engine_->contacts(), forcing_.environment_force(scene_.tow.body)); });
   // Which bodies the next step's forcing takes as touching (a contact with an impulse in this
   // step, on any engine: Engine::contacts): their step stays first order, the others' second.
   if (!forcing_.empty()) {

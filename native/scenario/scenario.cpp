@@ -364,7 +364,7 @@ void read_tow(TableReader& root, Scene& scene, const GeoProjection* geo) {
   if (!t) return;
   TableReader r(*t, scene.source_path, "tow");
   TowSpec& tow = scene.tow;
-  const std::string mode = r.string("mode", std::nullopt, {"velocity", "rope"});
+  const std::string mode = r.string("mode", std::nullopt, {"velocity", "rope", "tug"});
   const std::string name = r.string("body", std::nullopt);
   bool found = false;
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
@@ -375,24 +375,50 @@ void read_tow(TableReader& root, Scene& scene, const GeoProjection* geo) {
   if (!found) r.fail("body", "no body is named \"" + name + "\"");
   BodySpec& b = scene.bodies[tow.body];
   if (b.fixed) r.fail("body", "\"" + name + "\" is fixed and cannot be towed");
+  tow.stall_speed = r.real("stall_speed", 0.1, Range::closed(0.0, 10.0));
   if (mode == "velocity") {
     tow.mode = TowSpec::Mode::velocity;
     tow.path = read_path(r, "velocity", "path");
     b.prescribed = true;
     b.velocity = tow.velocity_at(0.0);  // the towed body starts on its path, heading held
     b.angular_velocity = 0.0;
-  } else {
+    r.reject_unknown();
+    return;
+  }
+  if (mode == "rope") {
     tow.mode = TowSpec::Mode::rope;
     tow.path = read_path(r, "tug_velocity", "tug_path");
-    tow.stiffness = r.real("stiffness", std::nullopt, Range::positive());
-    tow.length = r.real("length", std::nullopt, Range::positive());
-    tow.damping = r.real("damping", 0.0, Range::non_negative());
-    tow.attachment = r.vec2("attachment", Vec2{});
-    // Default tug start: the rope's length ahead of the attachment, along the tug's first velocity.
-    const Vec2 heading = length(tow.path.front().second) > 0.0 ? normalized(tow.path.front().second) : Vec2{1.0, 0.0};
-    const AreaMoments m = area_moments(b.polygon);
-    tow.tug_start = read_position(r, "tug_start", m.centroid + tow.attachment + tow.length * heading, geo);
+  } else {
+    tow.mode = TowSpec::Mode::tug;
+    tow.path = read_path(r, "direction", "direction_path");
+    for (std::size_t k = 0; k < tow.path.size(); ++k) {
+      const Vec2 h = tow.path[k].second;
+      const char* key = r.has("direction_path") ? "direction_path" : "direction";
+      if (!(length(h) > 0.0)) r.fail(key, "a heading must be a nonzero vector (row " + std::to_string(k) + ")");
+      // The heading between two rows is the direction of the interpolated vector: two that
+      // point nearly opposite ways would swing it through zero.
+      if (k > 0 && dot(normalized(h), normalized(tow.path[k - 1].second)) < -0.9)
+        r.fail(key, "consecutive headings must differ by less than 154 deg (rows " + std::to_string(k - 1) + " and " +
+                        std::to_string(k) + "); add a row between them");
+    }
+    // The thrust of a fixed-pitch propeller falls about linearly from the bollard pull at rest
+    // to the hull's resistance at the free-running speed (docs/towing.md).
+    tow.bollard_pull = r.real("bollard_pull", std::nullopt, Range{0.0, 1e8, true, false});
+    tow.free_running_speed = r.real("free_running_speed", std::nullopt, Range{0.0, 20.0, true, false});
+    // Default displacement: 2 kg per newton of bollard pull, about 20 t per tonne-force (between
+    // a harbour tug's 10 and an anchor handler's 40; docs/towing.md).
+    tow.tug_mass = r.real("tug_mass", 2.0 * tow.bollard_pull, Range{0.0, 1e10, true, false});
   }
+  tow.stiffness = r.real("stiffness", std::nullopt, Range::positive());
+  tow.length = r.real("length", std::nullopt, Range::positive());
+  tow.damping = r.real("damping", 0.0, Range::non_negative());
+  tow.attachment = r.vec2("attachment", Vec2{});
+  tow.breaking_load = r.real("breaking_load", 0.0, Range::non_negative());
+  // Default tug start: the rope's length ahead of the attachment, along the tug's first
+  // velocity or heading.
+  const Vec2 heading = tow.direction();
+  const AreaMoments m = area_moments(b.polygon);
+  tow.tug_start = read_position(r, "tug_start", m.centroid + tow.attachment + tow.length * heading, geo);
   r.reject_unknown();
 }
 

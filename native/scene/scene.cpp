@@ -124,4 +124,18 @@ Vec2 TowSpec::displacement(double t0, double t1) const {
   return d;
 }
 
+Vec2 TowSpec::heading_at(double t) const {
+  const Vec2 h = velocity_at(t);
+  const double n = floedem::length(h);
+  // The interpolated vector passes near zero only between two headings that point nearly
+  // opposite ways, which the scenario reader refuses.
+  return n > 0.0 ? (1.0 / n) * h : direction();
+}
+
+Vec2 TowSpec::direction() const {
+  for (const auto& [t, v] : path)
+    if (floedem::length(v) > 0.0) return normalized(v);
+  return {1.0, 0.0};
+}
+
 }  // namespace floedem

@@ -7,6 +7,8 @@
     run.polygons(-1)             # world polygons at the last frame
     run.collisions.peak_force    # [E] N
     run.tow.ice_force_mean       # [W, 2] N
+    run.tow.outcome              # the tow's outcome: speed made good, parting, tensions
+    floedem.towing.odds(...), floedem.towing.design_loads(...)   # odds and design loads
     floedem.stats.stationary_window(...), floedem.stats.block_standard_error(...)
     floedem.forcing.write_grid(...), floedem.forcing.write_series(...)   # forcing files
     floedem.geojson.export("drift.h5")   # a geographic scene's run for QGIS
@@ -21,7 +23,8 @@ from .errors import FileError  # noqa: F401
 
 # numpy and h5py load on the first use of what needs them (PEP 562), not at `import floedem`:
 # the workflow runs `python3 -m floedem launch-one` once per job, hundreds of times a report.
-_LAZY = {"open": "run", "Run": "run", "FORMAT_VERSION": "run", "stats": None, "forcing": None, "geojson": None, "chart": None}
+_LAZY = {"open": "run", "Run": "run", "FORMAT_VERSION": "run", "stats": None, "forcing": None, "geojson": None, "chart": None,
+         "towing": None}
 
 
 def __getattr__(name):
@@ -38,4 +41,4 @@ def __dir__():
 
 
 __version__ = "0.1.0"
-__all__ = ["open", "Run", "FileError", "FORMAT_VERSION", "stats", "forcing", "geojson", "chart", "__version__"]
+__all__ = ["open", "Run", "FileError", "FORMAT_VERSION", "stats", "forcing", "geojson", "chart", "towing", "__version__"]

@@ -82,7 +82,7 @@ def animate(run_path, out, colour="speed", fps=12, dpi=100, progress=True):
         writer = FFMpegWriter(fps=fps, extra_args=["-f", fmt] + (["-pix_fmt", "yuv420p"] if fmt == "mp4" else []))
         with open(partial, "wb"):   # an unwritable place is told now, not after the drawing
             pass
-        attachment = _rope(run) if tow is not None and tow.attrs.get("mode") == "rope" else None
+        attachment = _rope(run) if tow is not None and tow.attrs.get("mode") in ("rope", "tug") else None
         start = last = clock.monotonic()
         try:
             with writer.saving(fig, partial, dpi):

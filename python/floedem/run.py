@@ -24,6 +24,9 @@ _COLLISIONS = {"time": (), "body_a": (), "body_b": (), "normal_impulse": (), "ef
 # With [contact] force_model = "pressure_area" (the group's attribute force_model says so).
 _COLLISIONS_CRUSHING = {"contact_width": (), "crushed": ()}
 _TOW = {"time": (), "force": (2,), "force_mean": (2,), "ice_force_mean": (2,), "tug_position": (2,)}
+# A rope's tow (modes rope and tug, /tow's attribute mode) adds its tension; a tug its velocity.
+_TOW_ROPE = {"tension_max": ()}
+_TOW_TUG = {"tug_velocity": (2,)}
 _LOADS = {"time": (), "force": ("B", 2)}
 
 
@@ -157,7 +160,12 @@ class Run:
                                     dict(_COLLISIONS, **(_COLLISIONS_CRUSHING if crushing else {})), {})
         # The files the scenario read, by scenario key: "fnv1a64 DIGEST, N bytes, PATH" ({} if none).
         self.inputs = _attrs(f["inputs"]) if "inputs" in f else {}
-        self.tow = Table(self, "tow", _TOW, {}) if "tow/time" in f else None
+        self.tow = None
+        if "tow/time" in f:
+            mode = _attrs(f["tow"]).get("mode")
+            fields = dict(_TOW, **(_TOW_ROPE if mode in ("rope", "tug") else {}), **(_TOW_TUG if mode == "tug" else {}))
+            self.tow = Table(self, "tow", fields, {})
+            self.tow.outcome = self._tow_outcome()
         if "loads/time" in f:
             b = f["loads/body"][()] if "body" in f["loads"] else None
             if b is None or b.ndim != 1 or np.any(b < 0) or np.any(b >= n):
@@ -178,6 +186,19 @@ class Run:
             if f["bodies/lonlat"].shape != (len(self.time), n, 2):
                 raise self._error("/bodies/lonlat", f"has shape {f['bodies/lonlat'].shape}; expected "
                                                     f"{(len(self.time), n, 2)}")
+
+    def _tow_outcome(self):
+        """The tow's outcome over the run (docs/towing.md), from the summary's tow_* attributes:
+        direction [2], distance and cross_track (m), speed_made_good and stall_speed (m/s),
+        stalled_time and parted_at (s; NaN when the rope held), parted (bool), tension_max and
+        tension_p99 (N). None for a run not finished, or written before floedem recorded it."""
+        s = {k[len("summary_tow_"):]: v for k, v in self.attrs.items() if k.startswith("summary_tow_")}
+        if "distance" not in s:
+            return None
+        out = {k: float(v) for k, v in s.items() if k not in ("direction_x", "direction_y", "parted")}
+        out["direction"] = np.array([s.get("direction_x", np.nan), s.get("direction_y", np.nan)], float)
+        out["parted"] = bool(s.get("parted", 0.0) == 1.0)
+        return out
 
     # Frames -----------------------------------------------------------------------------------
     @property

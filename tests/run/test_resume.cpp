@@ -217,6 +217,30 @@ TEST_CASE("resume: a run killed mid-way and continued gives the uninterrupted ru
   fs::remove_all(f.dir);
 }
 
+TEST_CASE("resume: a tug's tow whose rope parted, killed and continued gives the uninterrupted run's file",
+          "[resume][tug]") {
+  // The tow line's own state (the tug's place and speed, the parting, the outcome's tallies)
+  // must come back from a checkpoint: the rope parts near t = 5 s, the kill comes at step 777.
+  std::string text = kScenario;
+  const std::string rope = "mode = \"rope\"\nbody = \"iceberg\"\ntug_velocity = [0.8, 0.1]\n";
+  REQUIRE(text.find(rope) != std::string::npos);
+  text.replace(text.find(rope), rope.size(),
+               "mode = \"tug\"\nbody = \"iceberg\"\ndirection = [1.0, 0.1]\nbollard_pull = 4e5\n"
+               "free_running_speed = 5.0\nbreaking_load = 6e5\n");
+  const Files f = write_scenario("tug", text);
+  REQUIRE(test::run_cli(run_args(f, "whole.h5")).code == 0);
+  const Contents whole = contents(f.dir / "whole.h5");
+  REQUIRE(whole.count("/tow/tug_velocity"));
+  REQUIRE(whole.count("/@summary_tow_parted_at"));
+  REQUIRE(test::run_cli(run_args(f, "cut.h5"), "FLOEDEM_TEST_KILL_AT_STEP=777 ").code != 0);
+  const auto resumed = test::run_cli("run --resume " + (f.dir / "cut.h5").string());
+  INFO(resumed.output);
+  REQUIRE(resumed.code == 0);
+  CHECK(resumed.output.find("parted at t = ") != std::string::npos);
+  check_same_contents(whole, f.dir / "cut.h5");
+  fs::remove_all(f.dir);
+}
+
 TEST_CASE("resume: a geographic run killed and continued gives the uninterrupted run's file", "[resume][geo]") {
   // The same scene on the earth (docs/geography.md): each body's Coriolis parameter comes from
   // tiles of a lattice built as the bodies reach them, and /bodies/lonlat is written per frame.

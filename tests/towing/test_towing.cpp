@@ -139,7 +139,7 @@ TEST_CASE("a slack rope carries nothing", "[tow]") {
   const Scene s = test::scene_from(text);
   BodyStates st;
   st.resize(1);
-  const RopeState r = rope_state(s.tow, st, 0.0);
+  const RopeState r = rope_state(s.tow, TowLine(s.tow), nullptr, st, 0.0);
   CHECK(r.length == Approx(200.0));
   CHECK(r.tension == 0.0);
 }

@@ -4,12 +4,30 @@
 // that a run continued with --resume (whose earlier rows are only in the file) gives the same
 // figures as one never interrupted.
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
 #include "floedem/geometry/vec2.hpp"
 
 namespace floedem {
+
+/// A tow's outcome over its run (docs/towing.md): what a planner judges a tow by. The run
+/// writes it with its summary (the root attributes summary_tow_*, docs/output.md).
+struct TowOutcome {
+  Vec2 direction;               ///< unit: the direction the tow is meant to go ([tow] path's first)
+  double distance = 0.0;        ///< m, the towed body's displacement along `direction`
+  double cross_track = 0.0;     ///< m, across it (positive to its left)
+  double speed_made_good = 0.0; ///< m/s, distance over the run's time
+  double stall_speed = 0.0;     ///< m/s, [tow] stall_speed
+  double stalled_time = 0.0;    ///< s, the steps that ended with the body slower than stall_speed along `direction`
+  bool parted = false;          ///< the rope parted (modes rope and tug)
+  double parted_at = 0.0;       ///< s, the start of the step it parted in (NaN when it held)
+  double tension_max = 0.0;     ///< N, the rope's largest tension while whole (rope, tug; 0 otherwise)
+  double tension_p99 = 0.0;     ///< N, its 99th percentile over the steps while whole, within 0.6 %
+  /// As the summary's attributes, without their "summary_" prefix.
+  std::vector<std::pair<std::string, double>> attributes() const;
+};
 
 struct RunHeadline {
   /// s: the tow and load means are over the rows from here to the end (the second half of
@@ -23,6 +41,7 @@ struct RunHeadline {
     Vec2 ice_force;  ///< N, its ice part (minus the contact force on the towed body)
   };
   std::optional<Tow> tow;
+  std::optional<TowOutcome> tow_outcome;  ///< from the summary (a file written before it has none)
   struct Load {
     std::string body;
     Vec2 force;  ///< N, mean contact force on the body

@@ -177,22 +177,45 @@ struct EnvironmentSpec {
   Vec2 wind_change(double t) const { return wind_series.empty() ? Vec2{} : wind_series.at(t); }
 };
 
-/// [tow]: an iceberg moved on a prescribed velocity, or pulled by a rope from a tug.
+/// [tow]: an iceberg moved on a prescribed velocity, pulled by a rope from a tug on a given
+/// path, or pulled by a tug that has only so much pull (docs/towing.md).
 struct TowSpec {
-  enum class Mode : std::uint8_t { none, velocity, rope };
+  enum class Mode : std::uint8_t { none, velocity, rope, tug };
   Mode mode = Mode::none;
   std::size_t body = 0;
   /// Piecewise-linear velocity against time [(t, v)], held after the last point. The towed
-  /// body's (mode velocity) or the tug's (mode rope).
+  /// body's (mode velocity), the tug's (mode rope) or, mode tug, the tug's heading (a
+  /// direction: the interpolated vector's direction, heading_at).
   std::vector<std::pair<double, Vec2>> path;
-  double stiffness = 0.0;          ///< N/m (rope)
-  double length = 0.0;             ///< m, unstretched (rope)
-  double damping = 0.0;            ///< N s/m (rope)
-  Vec2 attachment;                 ///< m, in the body's frame from its centroid (rope)
-  Vec2 tug_start;                  ///< m, world (rope)
+  double stiffness = 0.0;          ///< N/m (rope, tug)
+  double length = 0.0;             ///< m, unstretched (rope, tug)
+  double damping = 0.0;            ///< N s/m (rope, tug)
+  Vec2 attachment;                 ///< m, in the body's frame from its centroid (rope, tug)
+  Vec2 tug_start;                  ///< m, world (rope, tug)
+  /// N: the rope parts at the start of the first step whose tension exceeds it (rope, tug;
+  /// 0: it never parts).
+  double breaking_load = 0.0;
+  // Mode tug: the pull available at speed V through the water along the heading is
+  // bollard_pull (1 - V / free_running_speed), bollard_pull itself at V <= 0.
+  double bollard_pull = 0.0;       ///< N
+  double free_running_speed = 0.0; ///< m/s
+  double tug_mass = 0.0;           ///< kg
+  /// m/s: the towing outcome counts the time the towed body makes less than this along the
+  /// tow's direction as stalled.
+  double stall_speed = 0.1;
   Vec2 velocity_at(double t) const;
   Vec2 acceleration_at(double t) const;
   Vec2 displacement(double t0, double t1) const;  ///< integral of the path velocity
+  /// Mode tug: the unit heading at time t.
+  Vec2 heading_at(double t) const;
+  /// The direction the tow is meant to go, for its outcome: the first nonzero vector of the
+  /// path (the towed body's or the tug's velocity, or the tug's heading); +x when none is.
+  Vec2 direction() const;
+  bool has_rope() const { return mode == Mode::rope || mode == Mode::tug; }
+  /// The mode as the scenario and /tow's attribute `mode` spell it.
+  const char* mode_name() const {
+    return mode == Mode::velocity ? "velocity" : mode == Mode::rope ? "rope" : mode == Mode::tug ? "tug" : "none";
+  }
 };
 
 /// Where part of a scene came from, for the output: attributes of one group (a generated
