@@ -408,6 +408,7 @@ void read_tow(TableReader& root, Scene& scene, const GeoProjection* geo) {
     // Default displacement: 2 kg per newton of bollard pull, about 20 t per tonne-force (between
     // a harbour tug's 10 and an anchor handler's 40; docs/towing.md).
     tow.tug_mass = r.real("tug_mass", 2.0 * tow.bollard_pull, Range{0.0, 1e10, true, false});
+    tow.pull_ramp = r.real("pull_ramp", 0.0, Range::closed(0.0, 1e6));
   }
   tow.stiffness = r.real("stiffness", std::nullopt, Range::positive());
   tow.length = r.real("length", std::nullopt, Range::positive());

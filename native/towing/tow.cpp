@@ -41,15 +41,17 @@ RopeState rope_state(const TowSpec& tow, const TowLine& line, const EnvironmentS
   return r;
 }
 
-std::array<double, 2> tug_pull(const TowSpec& tow, double speed) {
+std::array<double, 2> tug_pull(const TowSpec& tow, double speed, double t) {
   // A fixed-pitch propeller's thrust less the hull's resistance falls about linearly from the
   // bollard pull at rest to zero at the free-running speed (US Navy Towing Manual, SL740-AA-
   // MAN-010, 5-8; Fossen, Handbook of Marine Craft Hydrodynamics and Motion Control, 2011,
   // 9.2: thrust T = T_0 (1 - V_a / (n D)) at a fixed propeller speed). Past V_f the line goes
   // on (the hull's resistance exceeds the thrust); astern (V < 0) the pull is held at P_B.
-  if (speed < 0.0) return {tow.bollard_pull, 0.0};
-  const double slope = tow.bollard_pull / tow.free_running_speed;
-  return {tow.bollard_pull - slope * speed, -slope};
+  // A tug throttles up over pull_ramp rather than snatching a taut line at full power.
+  const double pull = tow.pull_ramp > 0.0 ? std::min(1.0, t / tow.pull_ramp) * tow.bollard_pull : tow.bollard_pull;
+  if (speed < 0.0) return {pull, 0.0};
+  const double slope = pull / tow.free_running_speed;
+  return {pull - slope * speed, -slope};
 }
 
 void TensionHistogram::add(double tension) {
@@ -135,7 +137,7 @@ void TowMonitor::after_step(const BodyStates& state, std::span<const ContactReco
     // -(c + dt k) (e . h)^2, since T grows by c and, over the step, dt k per m/s the tug
     // makes along the rope. Then the position, with the new speed (semi-implicit Euler).
     const Vec2 h = tow_.heading_at(time_);
-    const auto [pull, slope] = tug_pull(tow_, line_.speed);
+    const auto [pull, slope] = tug_pull(tow_, line_.speed, time_);
     const double along = dot(rope_.direction, h);
     const double rope = -rope_.tension * along;
     const double jacobian = slope - (rope_.tension > 0.0 ? (tow_.damping + dt * tow_.stiffness) * along * along : 0.0);
@@ -161,7 +163,8 @@ TowOutcome TowMonitor::outcome(const BodyStates& state, double time) const {
   o.parted = line_.parted;
   o.parted_at = line_.parted ? line_.parted_at : std::numeric_limits<double>::quiet_NaN();
   o.tension_max = tension_max_;
-  o.tension_p99 = tensions_.quantile(0.99);
+  // The histogram's bin centre can lie above the largest tension itself, which is exact.
+  o.tension_p99 = std::min(tensions_.quantile(0.99), tension_max_);
   return o;
 }
 

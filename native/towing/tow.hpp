@@ -40,9 +40,10 @@ struct RopeState {
 RopeState rope_state(const TowSpec& tow, const TowLine& line, const EnvironmentSpec* environment,
                      const BodyStatesView& s, double t);
 
-/// The pull a tug of mode tug has at speed V (m/s) through the water along its heading:
-/// P(V) = P_B (1 - V / V_f) for V >= 0, P_B for V < 0 (docs/towing.md), and dP/dV.
-std::array<double, 2> tug_pull(const TowSpec& tow, double speed);
+/// The pull a tug of mode tug has at speed V (m/s) through the water along its heading at time
+/// t: P(V) = r(t) P_B (1 - V / V_f) for V >= 0, r(t) P_B for V < 0, with r(t) = min(1, t / pull_ramp)
+/// (docs/towing.md); and dP/dV.
+std::array<double, 2> tug_pull(const TowSpec& tow, double speed, double t = 1e300);
 
 /// What the recorder writes per frame: the step's towing force, and the means over the frame's
 /// steps of the towing force and of its ice part.

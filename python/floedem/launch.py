@@ -8,6 +8,8 @@ retried (twice) unless it may fail (its failure is then recorded, not retried). 
 by a signal (a cluster's SIGTERM: `floedem run` checkpoints its step first) leaves no record,
 and where it names how to continue its output, the next try continues it rather than starting
 over."""
+import csv
+import io
 import json
 import os
 import signal
@@ -54,6 +56,16 @@ def write_atomic(path, text):
     with open(path + ".partial", "w") as f:
         f.write(text)
     os.replace(path + ".partial", path)
+
+
+def csv_text(columns, rows):
+    """Rows (dicts) as CSV text with a header, floats as repr (they read back to the bit)."""
+    out = io.StringIO(newline="")
+    w = csv.DictWriter(out, fieldnames=columns)
+    w.writeheader()
+    for row in rows:
+        w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in row.items()})
+    return out.getvalue()
 
 
 def write(jobs, workdir, label):

@@ -9,7 +9,6 @@ varied parameter. The format is docs/sweeps.md of the repository.
 Runs are named by a hash of what makes them (the scenario's text, the overrides, the engine, the
 floedem version): one whose summary exists is not run again, a failed one is retried, a killed
 native run continues from its checkpoint (floedem run --resume)."""
-import csv
 import hashlib
 import itertools
 import json
@@ -24,10 +23,11 @@ import numpy as np
 
 from . import figures as figs
 from . import tdist
-from .launch import Job, launch, write_atomic
+from . import towing
+from .launch import Job, csv_text, launch, write_atomic
 from .run import FileError, Run
 
-KEYS = {"scenario", "engines", "set", "vary", "seeds", "figures", "threads_per_run"}
+KEYS = {"scenario", "engines", "set", "vary", "seeds", "figures", "threads_per_run", "decision"}
 
 
 class SweepError(ValueError):
@@ -106,9 +106,15 @@ def load(path):
     if not isinstance(seed_keys, list) or not seed_keys or not all(isinstance(k, str) for k in seed_keys):
         raise SweepError(f"{path}: seeds.keys: allowed a non-empty list of keys (run.seed: the field's too, "
                          "unless its [field] gives a seed of its own)")
+    decision = None
+    if "decision" in spec:
+        try:
+            decision = towing.check_decision(spec["decision"], path, list(points))
+        except ValueError as e:
+            raise SweepError(str(e)) from None
     figures = spec.get("figures", {})
-    if not isinstance(figures, dict) or not figures:
-        raise SweepError(f"{path}: figures: required, at least one [figures.NAME] table")
+    if not isinstance(figures, dict) or (not figures and decision is None):
+        raise SweepError(f"{path}: figures: required, at least one [figures.NAME] table (or a [decision] table)")
     for name, f in figures.items():
         if not isinstance(f, dict):
             raise SweepError(f"{path}: figures.{name}: allowed a table")
@@ -120,7 +126,7 @@ def load(path):
     if not (isinstance(threads, int) and 1 <= threads <= 256):
         raise SweepError(f"{path}: threads_per_run: {threads!r}; allowed 1 to 256")
     return dict(path=os.path.abspath(path), scenario=scenario, engines=engines, set=common, vary=points,
-                seeds=seed_values, seed_keys=seed_keys, figures=figures, threads_per_run=threads)
+                seeds=seed_values, seed_keys=seed_keys, figures=figures, threads_per_run=threads, decision=decision)
 
 
 def _floedem_text(floedem, *args):
@@ -215,7 +221,8 @@ def sweep(spec_path, out, floedem, jobs=None, profile=None, dry_run=False):
               file=sys.stderr)
         return status or 4
     reduce(sweep_json)
-    print(f"sweep: {os.path.join(out, 'reduced.csv')} and its plots in {os.path.join(out, 'plots')} "
+    decisions = f", {os.path.join(out, 'decisions.md')}" if s["spec"].get("decision") is not None else ""
+    print(f"sweep: {os.path.join(out, 'reduced.csv')}{decisions} and plots in {os.path.join(out, 'plots')} "
           f"({time.monotonic() - start:.1f} s)")
     return 0
 
@@ -265,6 +272,8 @@ def run_one(sweep_json, job_id):
                        overrides=job["overrides"], scenario=s["spec"]["scenario"],
                        floedem_version=run.attrs.get("floedem_version"), steps=run.summary.get("steps"),
                        wall_seconds=wall if how != "reused" else None, how=how, figures=values)
+        if s["spec"].get("decision") is not None:
+            summary["tow"] = towing.run_record(run)
     _write_json(out[:-3] + ".summary.json", summary)
     return 0
 
@@ -310,11 +319,10 @@ def reduce(sweep_json):
         [f"{name}_{q}" for name in names for q in ("mean", "std", "ci95", "n")]
     tmp = os.path.join(out, "reduced.csv.partial")
     with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=columns)
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in row.items()})
+        f.write(csv_text(columns, rows))
     _plots(out, rows, keys, names, s["spec"]["engines"])
+    if s["spec"].get("decision") is not None:
+        towing.write_decisions(out, summaries, keys, s["spec"]["decision"])
     os.replace(tmp, os.path.join(out, "reduced.csv"))
     return rows
 

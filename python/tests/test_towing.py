@@ -1,6 +1,7 @@
 """floedem.towing: the odds and the design loads on samples with known answers, and a tug's
 outcome read back from its run."""
 import math
+import os
 
 import numpy as np
 import pytest
@@ -125,3 +126,68 @@ def test_a_tugs_outcome_read_back(tmp_path):
         assert list(o["direction"]) == [1.0, 0.0]
         assert o["speed_made_good"] == pytest.approx(o["distance"] / 300.0)
         assert not towing.succeeded(o)
+
+
+PLAN = """
+scenario = "{scenario}"
+[vary]
+"tow.bollard_pull" = [3e4, 6e4]
+[seeds]
+count = 10
+[decision]
+min_speed = 0.3
+probability = 0.8
+periods = [10, 100]
+"""
+
+
+def test_a_planning_sweep_gives_the_odds_the_smallest_pull_and_design_loads(tmp_path):
+    # Two pulls x 10 field seeds of a small berg towed through 60 % ice (tug_field.toml): the
+    # smaller pull makes about 0.22 m/s, the larger 0.36. The reduction against the runs' own
+    # outcomes: the odds and their interval, the partings and the GEV levels.
+    import csv
+    here = os.path.dirname(os.path.abspath(__file__))
+    spec = tmp_path / "plan.toml"
+    spec.write_text(PLAN.format(scenario=os.path.join(here, "tug_field.toml")))
+    out = tmp_path / "plan"
+    r = run_floedem("sweep", str(spec), "--out", str(out), "--jobs", "2")
+    assert "decisions.md" in r.stdout
+    with open(out / "decisions.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 2
+    outcomes = {}
+    for h5 in (out / "runs").glob("*.h5"):
+        with floedem.open(h5) as run:
+            pull = float([o for o in run.attrs["overrides"].split("\n") if o.startswith("tow.bollard_pull=")][0]
+                         .split("=")[1])
+            outcomes.setdefault(pull, []).append(towing.run_record(run))
+    for row in rows:
+        mine = outcomes[float(row["tow.bollard_pull"])]
+        assert len(mine) == 10
+        expect = towing.odds([towing.succeeded(o, min_speed=0.3) for o in mine])
+        assert float(row["p"]) == expect["p"] and float(row["lo"]) == pytest.approx(expect["lo"])
+        assert int(row["parted"]) == sum(o["parted"] for o in mine)
+        fit = towing.gev_fit([o["tension_max"] for o in mine])
+        assert float(row["tension_max_10_level"]) == pytest.approx(towing.return_level(fit, 10), rel=1e-9)
+        assert float(row["tension_max_100_level"]) >= float(row["tension_max_10_level"])
+    text = (out / "decisions.md").read_text()
+    assert "| engine | tow.bollard_pull | n | successes | p | lo | hi | parted |" in text
+    assert "The smallest `tow.bollard_pull`" in text
+    assert [float(r["p"]) for r in sorted(rows, key=lambda r: float(r["tow.bollard_pull"]))] == [0.0, 1.0]
+    assert (out / "plots" / "towability.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("edit, needle", [
+    ("probability = 0.8", "decision.probability"),
+    ("periods = [10, 100]", "decision.periods"),
+    ("min_speed = 0.3", "decision.min_speed"),
+])
+def test_bad_decision_tables_are_refused_before_any_run(tmp_path, edit, needle):
+    here = os.path.dirname(os.path.abspath(__file__))
+    bad = {"probability = 0.8": "probability = 1.5", "periods = [10, 100]": "periods = [1, 10]",
+           "min_speed = 0.3": "min_speed = -1.0"}[edit]
+    spec = tmp_path / "plan.toml"
+    spec.write_text(PLAN.format(scenario=os.path.join(here, "tug_field.toml")).replace(edit, bad))
+    r = run_floedem("sweep", str(spec), "--out", str(tmp_path / "o"), check=False)
+    assert r.returncode == 2 and needle in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "o" / "runs").exists() or not any((tmp_path / "o" / "runs").iterdir())

@@ -10,8 +10,8 @@ _PYTHON = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.r
 if _PYTHON not in sys.path:
     sys.path.insert(0, _PYTHON)
 
-from sections import (channel, cost_error, engines, field, hindcast, impacts, observations, sensitivity,  # noqa: E402
-                      speed, stress, threads, towing)
+from sections import (channel, cost_error, decisions, engines, field, hindcast, impacts, observations,  # noqa: E402
+                      sensitivity, speed, stress, threads, towing)
 
-SECTIONS = [impacts, towing, field, channel, hindcast, observations, sensitivity, stress, speed, threads, cost_error,
-            engines]
+SECTIONS = [impacts, towing, decisions, field, channel, hindcast, observations, sensitivity, stress, speed, threads,
+            cost_error, engines]

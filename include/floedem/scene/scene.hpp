@@ -200,6 +200,7 @@ struct TowSpec {
   double bollard_pull = 0.0;       ///< N
   double free_running_speed = 0.0; ///< m/s
   double tug_mass = 0.0;           ///< kg
+  double pull_ramp = 0.0;          ///< s: the pull rises in proportion to t over this time (0: at once)
   /// m/s: the towing outcome counts the time the towed body makes less than this along the
   /// tow's direction as stalled.
   double stall_speed = 0.1;
