@@ -367,7 +367,7 @@ struct Recorder::Impl {
 };
 
 Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo& engine, const RunInfo& run)
-    : impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
+    : lock_(std::make_unique<OutputLock>(path)), impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
   H5::Exception::dontPrint();
   check_space(scene);
   try {
@@ -499,7 +499,7 @@ void Recorder::write_run_attributes(const Scene& scene, const RunInfo& run) {
 }
 
 Recorder::Recorder(const std::string& path, const Scene& scene, const RunInfo& run, const RecordedRows& rows)
-    : impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
+    : lock_(std::make_unique<OutputLock>(path)), impl_(std::make_unique<Impl>()), path_(path), partial_path_(path + ".partial") {
   namespace fs = std::filesystem;
   H5::Exception::dontPrint();
   const std::int64_t format = check_tables(fs::exists(partial_path_) ? partial_path_ : path_, scene, rows);

@@ -15,6 +15,7 @@
 #include "contacts/collision_forces.hpp"
 #include "floedem/engine/engine.hpp"
 #include "floedem/io/output.hpp"
+#include "io/output_lock.hpp"
 #include "floedem/scene/scene.hpp"
 #include "towing/tow.hpp"
 
@@ -103,6 +104,7 @@ class Recorder {
   /// Removes the stopped run's checkpoint, if there is one.
   void drop_stop_checkpoint();
   struct Impl;
+  std::unique_ptr<OutputLock> lock_;  // first: taken before the file is touched, given up last
   std::unique_ptr<Impl> impl_;
   std::string path_;
   std::string partial_path_;

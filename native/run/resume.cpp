@@ -4,6 +4,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "io/output_lock.hpp"
 #include "io/recorder.hpp"
 #include "floedem/scenario/scenario.hpp"
 #include "floedem/scene/input_error.hpp"
@@ -42,6 +43,9 @@ ResumeResult resume_run(const std::string& path, const std::vector<std::string>&
     if (override_key(o) != "run.duration")
       throw InputError("--resume " + path + ": --set " + o +
                        ": only run.duration may be set when a run is continued (anything else would make another run)");
+  // A run still writing the file holds its lock (io/output_lock.hpp): say so, rather than that
+  // the file cannot be read (HDF5 refuses to open a file another process has open for writing).
+  { const OutputLock probe(final_path); }
   const StoredRun run = read_stored_run(stored);
   std::vector<std::string> merged;
   for (const std::string& o : run.overrides)

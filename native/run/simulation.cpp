@@ -369,6 +369,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   Progress progress(options.progress, first - 1);
   const std::int64_t kill_at = test_signal_step("FLOEDEM_TEST_KILL_AT_STEP");
   const std::int64_t term_at = test_signal_step("FLOEDEM_TEST_TERM_AT_STEP");
+  const std::int64_t int_at = test_signal_step("FLOEDEM_TEST_INT_AT_STEP");
   for (std::int64_t k = first; k <= steps; ++k) {
     try {
       run.step(k);
@@ -382,6 +383,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     progress.update(k, steps);
     if (k == kill_at) std::raise(SIGKILL);
     if (k == term_at) std::raise(SIGTERM);
+    if (k == int_at) std::raise(SIGINT);
     if (options.stop && k < steps && options.stop->load(std::memory_order_relaxed)) {
       progress.done();
       const bool saved = run.checkpoint_on_stop(k);

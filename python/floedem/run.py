@@ -107,6 +107,10 @@ class Run:
         try:
             self._file = h5py.File(self.path, "r")
         except OSError as e:
+            if "unable to lock file" in str(e):
+                # HDF5's own lock: a floedem run has the file open for writing.
+                raise FileError(f"{self.path}: a run is writing it (the file is locked); open it once the run has "
+                                "ended or been stopped, or open a copy") from None
             raise FileError(f"{self.path}: not an HDF5 file ({e}); floedem's runs and fields are") from None
         try:
             self._check()
