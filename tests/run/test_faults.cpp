@@ -27,12 +27,12 @@ namespace {
 // A berg towed by a tug through some 370 floes (python/tests/tug_field.toml), 300 steps with a
 // frame each: a checkpoint every 88 frames, so kills fall before, between and after them. The
 // tug's line, the open collisions and the warm-started contacts all cross the checkpoints.
-const std::string kScene = std::string(FLOEDEM_SOURCE_DIR) + "/python/tests/tug_field.toml";
-const std::string kSets = " --set run.duration=75.0 --set run.output_every=1";
+const std::string kFaultScene = std::string(FLOEDEM_SOURCE_DIR) + "/python/tests/tug_field.toml";
+const std::string kFaultSets = " --set run.duration=75.0 --set run.output_every=1";
 constexpr int kSteps = 300;
 
 std::string run_args(const std::string& engine, const fs::path& out) {
-  return "run " + kScene + kSets + " -q -e " + engine + " --out " + out.string();
+  return "run " + kFaultScene + kFaultSets + " -q -e " + engine + " --out " + out.string();
 }
 
 /// Steps drawn at random in [1, kSteps - 1].
@@ -118,7 +118,7 @@ TEST_CASE("faults: a second run on a name another run is writing is refused, the
   const test::Contents before = test::contents(out.string() + ".partial");
   {
     const OutputLock held(out.string());
-    for (const std::string args : {run_args("native", out), std::string("run -q --resume ") + out.string()}) {
+    for (const std::string& args : {run_args("native", out), std::string("run -q --resume ") + out.string()}) {
       INFO(args);
       const auto r = test::run_cli(args);
       INFO(r.output);

@@ -15,7 +15,7 @@ const std::string kIceberg =
     "[[body]]\nname = \"berg\"\nkind = \"iceberg\"\npolygon = [[0,0],[50,0],[50,50],[0,50]]\ndraft = 40.0\nsail_height = 10.0\n";
 
 // A tug's tow without its pull: each case adds what it tests.
-const std::string kTug = "[tow]\nmode = \"tug\"\nbody = \"berg\"\ndirection = [1.0, 0.0]\nstiffness = 1e5\nlength = 100.0\n";
+const std::string kBadTug = "[tow]\nmode = \"tug\"\nbody = \"berg\"\ndirection = [1.0, 0.0]\nstiffness = 1e5\nlength = 100.0\n";
 
 std::string error_of(const std::string& text) {
   try {
@@ -82,10 +82,10 @@ TEST_CASE("bad scenarios are refused with file, field, line and range", "[input]
       {"keel layer too wide", kRun + kIceberg + "keel_layers = [[20.0, 1.0], [20.0, 11.0]]\n",
        {"'body[0].keel_layers'", "layer 1", "(0, 10]"}},
       // Towing by a tug (docs/towing.md).
-      {"tug without bollard pull", kRun + kIceberg + kTug + "free_running_speed = 6.0\n", {"'tow.bollard_pull'", "missing", "(0, 100000000]"}},
-      {"tug bollard pull zero", kRun + kIceberg + kTug + "bollard_pull = 0.0\nfree_running_speed = 6.0\n",
+      {"tug without bollard pull", kRun + kIceberg + kBadTug + "free_running_speed = 6.0\n", {"'tow.bollard_pull'", "missing", "(0, 100000000]"}},
+      {"tug bollard pull zero", kRun + kIceberg + kBadTug + "bollard_pull = 0.0\nfree_running_speed = 6.0\n",
        {"'tow.bollard_pull'", "(0, 100000000]"}},
-      {"tug free-running speed too high", kRun + kIceberg + kTug + "bollard_pull = 1e5\nfree_running_speed = 30.0\n",
+      {"tug free-running speed too high", kRun + kIceberg + kBadTug + "bollard_pull = 1e5\nfree_running_speed = 30.0\n",
        {"'tow.free_running_speed'", "(0, 20]"}},
       {"tug heading zero", kRun + kIceberg + "[tow]\nmode = \"tug\"\nbody = \"berg\"\ndirection = [0.0, 0.0]\n"
        "stiffness = 1e5\nlength = 100.0\nbollard_pull = 1e5\nfree_running_speed = 6.0\n",
@@ -94,11 +94,11 @@ TEST_CASE("bad scenarios are refused with file, field, line and range", "[input]
        "direction_path = [[0.0, 1.0, 0.0], [60.0, -1.0, 0.1]]\nstiffness = 1e5\nlength = 100.0\nbollard_pull = 1e5\n"
        "free_running_speed = 6.0\n",
        {"'tow.direction_path'", "154 deg", "rows 0 and 1"}},
-      {"tug mass zero", kRun + kIceberg + kTug + "bollard_pull = 1e5\nfree_running_speed = 6.0\ntug_mass = 0.0\n",
+      {"tug mass zero", kRun + kIceberg + kBadTug + "bollard_pull = 1e5\nfree_running_speed = 6.0\ntug_mass = 0.0\n",
        {"'tow.tug_mass'", "(0, 10000000000]"}},
-      {"negative breaking load", kRun + kIceberg + kTug + "bollard_pull = 1e5\nfree_running_speed = 6.0\nbreaking_load = -1.0\n",
+      {"negative breaking load", kRun + kIceberg + kBadTug + "bollard_pull = 1e5\nfree_running_speed = 6.0\nbreaking_load = -1.0\n",
        {"'tow.breaking_load'", "[0, inf)"}},
-      {"stall speed too high", kRun + kIceberg + kTug + "bollard_pull = 1e5\nfree_running_speed = 6.0\nstall_speed = 11.0\n",
+      {"stall speed too high", kRun + kIceberg + kBadTug + "bollard_pull = 1e5\nfree_running_speed = 6.0\nstall_speed = 11.0\n",
        {"'tow.stall_speed'", "[0, 10]"}},
       {"breaking load on a prescribed path", kRun + kIceberg + "[tow]\nmode = \"velocity\"\nbody = \"berg\"\n"
        "velocity = [0.5, 0.0]\nbreaking_load = 1e6\n",

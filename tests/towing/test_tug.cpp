@@ -22,18 +22,18 @@ namespace {
 
 // A 40 m square berg, 30 m draft, in calm open water (no wind, no current, no Coriolis): its
 // drag is quadratic in its speed, D(V) = D1 V^2, with neither a linear part nor a turn.
-const std::string kBerg =
+const std::string kTugBerg =
     "[environment]\n[[body]]\nname = \"berg\"\nkind = \"iceberg\"\n"
     "polygon = [[-20.0,-20.0],[20.0,-20.0],[20.0,20.0],[-20.0,20.0]]\ndraft = 30.0\nsail_height = 5.0\n";
 
-const std::string kTug =
+const std::string kTugTow =
     "[tow]\nmode = \"tug\"\nbody = \"berg\"\nbollard_pull = 1e5\nfree_running_speed = 6.0\ndirection = [1.0, 0.0]\n"
     "stiffness = 2e4\nlength = 200.0\ndamping = 1e4\n";
 
 /// D1 = D(1 m/s) / (1 m/s)^2, measured as the towing force that holds the berg at 1 m/s
 /// (mode velocity: the constraint force, minus the forcing, is the drag).
 double drag_coefficient() {
-  const Scene s = test::scene_from("[run]\nduration = 1.0\ndt = 1.0\n" + kBerg +
+  const Scene s = test::scene_from("[run]\nduration = 1.0\ndt = 1.0\n" + kTugBerg +
                                    "[tow]\nmode = \"velocity\"\nbody = \"berg\"\nvelocity = [1.0, 0.0]\n");
   Stepper run(s, "native");
   run.step();
@@ -50,7 +50,7 @@ std::string exact(double v) {
 }  // namespace
 
 TEST_CASE("tug: the pull falls linearly from the bollard pull to zero at the free-running speed", "[tow][tug]") {
-  const Scene s = test::scene_from("[run]\nduration = 1.0\ndt = 1.0\n" + kBerg + kTug);
+  const Scene s = test::scene_from("[run]\nduration = 1.0\ndt = 1.0\n" + kTugBerg + kTugTow);
   CHECK(tug_pull(s.tow, 0.0)[0] == 1e5);
   CHECK(tug_pull(s.tow, 3.0)[0] == Approx(5e4).epsilon(1e-15));
   CHECK(std::abs(tug_pull(s.tow, 6.0)[0]) < 1e-9);
@@ -68,7 +68,7 @@ TEST_CASE("tug in open water: the steady speed where the pull meets the drag, an
   const double pb = 1e5, b = pb / 6.0;
   const double v_star = (-b + std::sqrt(b * b + 4.0 * d1 * pb)) / (2.0 * d1);
   const double t_star = d1 * v_star * v_star;
-  const Scene s = test::scene_from("[run]\nduration = 1500.0\ndt = 1.0\n" + kBerg + kTug);
+  const Scene s = test::scene_from("[run]\nduration = 1500.0\ndt = 1.0\n" + kTugBerg + kTugTow);
   Stepper run(s, "native");
   for (int k = 0; k < 1500; ++k) run.step();
   // The transient decays as exp(-t / tau), tau = (m + m_t) / (2 D1 V* + b), about 150 s here:
@@ -92,7 +92,7 @@ TEST_CASE("rope: it parts at the start of the first step whose tension exceeds t
   const std::string rope =
       "[tow]\nmode = \"rope\"\nbody = \"berg\"\ntug_path = [[0.0, 0.0, 0.0], [400.0, 1.5, 0.0]]\n"
       "stiffness = 2e4\nlength = 200.0\ndamping = 1e4\n";
-  const std::string head = "[run]\nduration = 400.0\ndt = 1.0\n" + kBerg;
+  const std::string head = "[run]\nduration = 400.0\ndt = 1.0\n" + kTugBerg;
   std::vector<double> tension;
   {
     const Scene s = test::scene_from(head + rope);
@@ -139,7 +139,7 @@ TEST_CASE("rope: it parts at the start of the first step whose tension exceeds t
 }
 
 TEST_CASE("tug: once the rope parts the berg drifts free and the tug runs to its free-running speed", "[tow][tug]") {
-  const Scene s = test::scene_from("[run]\nduration = 600.0\ndt = 1.0\n" + kBerg + kTug + "breaking_load = 5e4\n");
+  const Scene s = test::scene_from("[run]\nduration = 600.0\ndt = 1.0\n" + kTugBerg + kTugTow + "breaking_load = 5e4\n");
   Stepper run(s, "native");
   for (int k = 0; k < 600; ++k) run.step();
   REQUIRE(run.tow().line().parted);
@@ -165,7 +165,7 @@ TEST_CASE("tension histogram: the 99th percentile within half a bin", "[tow][tug
 TEST_CASE("tow outcome: written with the summary, read back by the headline", "[tow][tug][output]") {
   const fs::path dir = test::temp_dir("tug-outcome");
   const fs::path scenario = dir / "tug.toml";
-  std::ofstream(scenario) << "[run]\nduration = 300.0\ndt = 1.0\noutput_every = 10\n" + kBerg + kTug +
+  std::ofstream(scenario) << "[run]\nduration = 300.0\ndt = 1.0\noutput_every = 10\n" + kTugBerg + kTugTow +
                                  "breaking_load = 1.2e5\nstall_speed = 0.05\n";
   const fs::path out = dir / "tug.h5";
   const auto r = test::run_cli("run " + scenario.string() + " --out " + out.string());
