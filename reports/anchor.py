@@ -19,6 +19,7 @@ import subprocess
 import sys
 
 from sections.speed import EQUAL_ITERATIONS, equal
+from floedem.launch import csv_text, write_atomic  # noqa: E402  (on the path through sections)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FIELDS = ["host", "cpu", "floedem_version", "scenario", "round", "engine", "settings", "median_ms",
@@ -79,12 +80,7 @@ def main():
     machine = next(x for x in rows if x["engine"] == "native")
     for row in rows:
         row["host"], row["cpu"] = machine["host"], machine["cpu"]
-    tmp = a.out + ".tmp"
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS)
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(tmp, a.out)
+    write_atomic(a.out, csv_text(FIELDS, rows))
     return 0
 
 

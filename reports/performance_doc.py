@@ -11,12 +11,13 @@ import glob
 import os
 import sys
 
-from sections.speed import TARGET_PER_FLOE, per_floe_growth, stages  # the stage_ms column and the scaling, as the report reads them
+from sections.speed import TARGET_PER_FLOE, per_floe_growth, stages, work  # the stage_ms and work columns and the scaling, as the report reads them
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 LATEST = os.path.join(HERE, "latest")
 ANCHORS = os.path.join(HERE, "anchors")
+JAMS = os.path.join(HERE, "jam")
 DOC = os.path.join(ROOT, "docs", "performance.md")
 ENGINES = ["native", "box2d", "bullet", "ode"]
 
@@ -362,6 +363,50 @@ def anchor_table(rows):
     return md
 
 
+JAM = """\
+## Where the ice jams
+
+A field benchmark never jams about a heavy body; a drift or towing study does. `reports/jam.py`
+times native on such scenes twice, one thread: over the first minutes (the pack loose) and over
+the end of the run (jammed), and writes `reports/jam/HOST.csv`. The Barents drift scene is the
+heavy-light case: an iceberg of 9.3e8 kg among floes of 1.8e6 kg and up, a mass ratio of about
+500 to the smallest, and by its last hours nearly every floe is in contact (the contact
+fraction). Gauss-Seidel hands on only m/M of the reaction a sweep through such an island, so a
+point whose creep would take it past the allowed overlap within the step gets the island's
+normal impulses solved directly (`engine.native.direct_solve`, docs/model.md section 3). In the
+jam most steps need no direct solve (the median), and those that do cost tens of milliseconds
+(the p90): a sparse LDL^T of the 2 000 or so pressing points' system, about five pivoting
+rounds a solve and one factorisation a round, sharing one fill-reducing order
+(`native/solver/island_solve.cpp`), and three passes of friction sweeps about it. The trigger
+watches the creep, not only the step's closing: triggered only where a point closes by more
+than the allowed overlap in one step, the sweeps leave an iceberg pressing on its floes at
+5 mm/s after an impact (11.7 mm of overlap in the stress suite's mass-ratio ladder, against the
+1.1 mm it allows). The Gulf compaction and the towing
+case have no heavy-light island (a towed iceberg moves on its path: it counts as infinitely
+heavy and joins no island), and their jams cost what their contacts cost.
+"""
+
+
+def jam_table(rows):
+    """Per scene, the start and the jam: mean, median and p90 ms a step, contacts, sweeps, and
+    the contact solve's share of the step."""
+    md = ["| scene | phase | window (s) | mean ms | median | p90 | contact fraction | sweeps a step | contact solve, ms (share) |",
+          "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        st, wk = stages(r), work(r)
+        total = sum(st.values()) or float("nan")
+        solve = st.get("contact_solve", 0.0)
+        md.append(f"| {r['label']} | {r['phase']} | {float(r['window_s']):.0f} | {fmt(float(r['mean_ms']))} | "
+                  f"{fmt(float(r['median_ms']))} | {fmt(float(r['p90_ms']))} | {float(r['contact_fraction']):.2f} | "
+                  f"{wk.get('sweeps', float('nan')):.3g} | {solve:.3g} ({100 * solve / total:.0f} %) |")
+    starts = {r["label"]: float(r["mean_ms"]) for r in rows if r["phase"] == "start"}
+    ratios = [f"{r['label']} {float(r['mean_ms']) / starts[r['label']]:.1f}" for r in rows
+              if r["phase"] == "jam" and r["label"] in starts]
+    if ratios:
+        md += ["", "The jam's mean step over the start's: " + "; ".join(ratios) + "."]
+    return md
+
+
 def render():
     bench, threads = read("bench.csv"), read("threads.csv")
     first = bench[0]
@@ -403,6 +448,15 @@ def render():
     md += sweep_table(bench) + [""]
     md += ["Threads (native, `FLOEDEM_THREADS`; the same output file on every count):", ""]
     md += threads_table(threads) + [""]
+    jams = sorted(glob.glob(os.path.join(JAMS, "*.csv")))
+    if jams:
+        md += [JAM]
+        for path in jams:
+            with open(path, newline="") as f:
+                rows = list(csv.DictReader(f))
+            if rows:
+                md += [f"`reports/jam/{os.path.basename(path)}`: {rows[0]['cpu']} (host `{rows[0]['host']}`), "
+                       f"floedem {rows[0]['floedem_version']}:", ""] + jam_table(rows) + [""]
     md += [DEFAULTS, DROPPED]
     for path in sorted(glob.glob(os.path.join(ANCHORS, "*.csv"))):
         with open(path, newline="") as f:

@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -60,6 +61,11 @@ class IslandSolver {
   /// Point i (not pressing) approaches faster than its target by more than tolerance.
   bool approaching(std::span<const Manifold> manifolds, const BodyArrays& bodies, std::size_t i, double tolerance) const;
   bool solve_active(std::span<const Manifold> manifolds, const BodyArrays& bodies);
+  /// order_: the points in an elimination order of the matrix of all of them (a fill-reducing
+  /// one, found again only when the points join other bodies than last time).
+  void order_points(const BodyArrays& bodies);
+  /// body_start_, body_row_: the rows_ of each body (CSR), for `bodies` bodies.
+  void group_by_body(std::size_t bodies);
   bool solve_by_descent(std::span<const Manifold> manifolds, BodyArrays& bodies);
 
   std::vector<Point> points_;               // the islands' points
@@ -68,7 +74,9 @@ class IslandSolver {
   std::vector<double> normal_;              // per point: normal impulse being solved for
   std::vector<double> start_;               // per point: Gauss-Seidel's normal impulse (the descent's start)
   std::vector<double> free_velocity_;       // per point: u_n without the islands' impulses
-  std::vector<std::int32_t> rows_;          // per row: its point
+  std::vector<std::int32_t> rows_;          // per row: its point (in the order of order_)
+  std::vector<std::int32_t> order_;         // the points in elimination order (order_points)
+  std::vector<std::int32_t> ordered_for_;   // the bodies a, b of each point order_ was found for
   std::vector<std::int32_t> wrong_;         // points whose answer breaks their conditions
   ContactIslands islands_;                  // of the manifolds select() was given
   std::vector<std::uint8_t> chosen_;        // per island: solved
@@ -79,7 +87,8 @@ class IslandSolver {
   std::vector<double> free_angular_, saved_angular_;
   std::vector<Eigen::Triplet<double>> triplets_;
   Eigen::SparseMatrix<double> a_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+  Eigen::SparseMatrix<double> pattern_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::NaturalOrdering<int>> ldlt_;
   double refine_to_ = 0.0;  // m/s: the velocity residual the refinement stops at
   Trigger trigger_;
 };
