@@ -1,5 +1,7 @@
 #include "io/recorder.hpp"
 
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/statvfs.h>
 
 #include <H5Cpp.h>
@@ -16,6 +18,77 @@
 #include "io/h5_read.hpp"
 
 namespace floedem {
+
+namespace {
+
+/// H5Fflush, with the file's space reserved first. A flush writes the superblock, which holds
+/// the address where the file ends (its EOA), in the same pass as the cached metadata and
+/// chunks that it gives space past the old end. On a full disk or under a file-size limit the
+/// superblock at the front was written and the writes past the end failed: the file on disk
+/// was then shorter than its superblock said, and HDF5 refused to open it ("truncated file"),
+/// so a run stopped by a full disk could not be resumed. (Flushing each dataset first does not
+/// do: H5Dflush writes the chunk index in place, pointing past the superblock's end.) So the
+/// space a flush can take is reserved first (posix_fallocate): the EOA, every open dataset's
+/// cached chunks (flush_bound: a chunk gets its space when it leaves the chunk cache), the
+/// metadata cache, and a little room. A failure then comes before anything is
+/// written, and the file stays as its last flush left it: the state a kill leaves, which
+/// --resume continues. HDF5 cuts the file back to its EOA when it closes it.
+/// The most file space that flushing dataset `d` can take: the chunks its chunk cache holds,
+/// at most the cache's size and at most the dataset's whole size (in whole chunks). Not what
+/// it has been given (H5Dget_storage_size): asking flushes the cache, past the reservation.
+haddr_t flush_bound(hid_t d) {
+  const hid_t space = H5Dget_space(d), create = H5Dget_create_plist(d), access = H5Dget_access_plist(d),
+              type = H5Dget_type(d);
+  const int rank = space < 0 ? -1 : H5Sget_simple_extent_ndims(space);
+  const std::size_t element = type < 0 ? 0 : H5Tget_size(type);
+  std::size_t slots = 0, cache = 0;
+  double w0 = 0.0;
+  haddr_t whole = 0;
+  bool known = rank >= 0 && create >= 0 && element > 0 && access >= 0 &&
+               H5Pget_chunk_cache(access, &slots, &cache, &w0) >= 0;
+  if (known) {
+    std::vector<hsize_t> dims(static_cast<std::size_t>(rank)), chunk(static_cast<std::size_t>(rank), 0);
+    known = H5Sget_simple_extent_dims(space, dims.data(), nullptr) == rank;
+    const bool chunked = H5Pget_layout(create) == H5D_CHUNKED && H5Pget_chunk(create, rank, chunk.data()) == rank;
+    whole = element;
+    for (std::size_t k = 0; k < dims.size(); ++k) {
+      const hsize_t c = std::max<hsize_t>(chunked ? chunk[k] : dims[k], 1);
+      whole *= (dims[k] + c - 1) / c * c;
+    }
+    if (chunked) whole = std::min<haddr_t>(whole, cache);
+  }
+  if (space >= 0) H5Sclose(space);
+  if (create >= 0) H5Pclose(create);
+  if (access >= 0) H5Pclose(access);
+  if (type >= 0) H5Tclose(type);
+  if (!known) throw H5::FileIException("H5Fflush", "cannot read a dataset's shape");
+  return whole;
+}
+
+void flush_with_room(H5::H5File& file) {
+  const hid_t id = file.getId();
+  haddr_t bound = 0;
+  if (H5Fget_eoa(id, &bound) < 0) throw H5::FileIException("H5Fflush", "cannot find the file's end");
+  const unsigned types = H5F_OBJ_DATASET | H5F_OBJ_LOCAL;
+  const ssize_t count = H5Fget_obj_count(id, types);
+  std::vector<hid_t> datasets(static_cast<std::size_t>(std::max<ssize_t>(count, 0)));
+  if (count < 0 || H5Fget_obj_ids(id, types, datasets.size(), datasets.data()) < 0)
+    throw H5::FileIException("H5Fflush", "cannot list the open datasets");
+  for (const hid_t d : datasets) bound += flush_bound(d);
+  std::size_t max_size = 0, min_clean = 0, cached = 0;
+  int entries = 0;
+  if (H5Fget_mdc_size(id, &max_size, &min_clean, &cached, &entries) < 0)
+    throw H5::FileIException("H5Fflush", "cannot read the metadata cache's size");
+  bound += cached + (haddr_t{1} << 16);
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(id, H5P_DEFAULT, &handle) < 0 || !handle)
+    throw H5::FileIException("H5Fflush", "cannot find the file's descriptor");
+  const int error = posix_fallocate(*static_cast<const int*>(handle), 0, static_cast<off_t>(bound));
+  if (error != 0) throw H5::FileIException("H5Fflush", std::string("no room to flush: ") + std::strerror(error));
+  file.flush(H5F_SCOPE_GLOBAL);
+}
+
+}  // namespace
 
 // Not in the anonymous namespace: Series is a member type of Recorder::Impl, which has external
 // linkage, and a unity build (scripts/test.sh) that batches this file with others would then
@@ -362,7 +435,7 @@ struct Recorder::Impl {
   /// the run went (a flush at a clock-chosen moment moves HDF5's allocations).
   void flush() {
     write_buffers();
-    file.flush(H5F_SCOPE_GLOBAL);
+    flush_with_room(file);
   }
 };
 
@@ -479,8 +552,11 @@ Recorder::Recorder(const std::string& path, const Scene& scene, const EngineInfo
   } catch (const H5::Exception& e) {
     std::error_code ec;
     std::filesystem::remove(partial_path_, ec);
+    // The datasets' handles cannot be closed after a failed write either (see ~Recorder): left
+    // to the end of the process, so that the one-line error is all stderr gets.
+    static_cast<void>(impl_.release());
     throw OutputError(partial_path_ + ": cannot create output file (" + e.getDetailMsg() +
-                      "); is the directory there and writable?");
+                      "); is the directory there, writable and not full?");
   }
 }
 
@@ -560,7 +636,7 @@ void Recorder::drop_stop_checkpoint() {
     // stopped has none.
     if (d.file.openGroup("/checkpoint").getNumObjs() == 0 && H5Ldelete(d.file.getId(), "/checkpoint", H5P_DEFAULT) < 0)
       throw H5::FileIException("H5Ldelete", "/checkpoint");
-    d.file.flush(H5F_SCOPE_GLOBAL);
+    flush_with_room(d.file);
   } catch (const H5::Exception& e) {
     d.write_failed = true;
     throw OutputError(partial_path_ + ": could not drop the stopped run's checkpoint (" + e.getDetailMsg() + ")");
@@ -586,10 +662,10 @@ void Recorder::write_slot(const char* name, std::int64_t step, const std::vector
     if (size > 0) slot.write(state.data(), H5::PredType::NATIVE_UINT8);
     write_number_attribute(slot, "step", H5::PredType::NATIVE_INT64, step);
     write_number_attribute(slot, "checksum", H5::PredType::NATIVE_UINT64, slot_checksum(step, state));
-    d.file.flush(H5F_SCOPE_GLOBAL);
+    flush_with_room(d.file);
   } catch (const H5::Exception& e) {
     d.write_failed = true;
-    throw OutputError(partial_path_ + ": could not write a checkpoint (" + e.getDetailMsg() + "); disk full?");
+    throw OutputError(partial_path_ + ": could not write a checkpoint (" + e.getDetailMsg() + "); disk full? floedem run --resume continues it once there is room");
   }
 }
 
@@ -639,6 +715,16 @@ void Recorder::check_space(const Scene& scene) const {
   const double bytes =
       8.0 * (frames * ((scene.geo.present ? 8.0 : 6.0) * static_cast<double>(scene.bodies.size()) + 1.0) + 12.0 * tow_rows +
              load_rows * (1.0 + 2.0 * static_cast<double>(scene.output.load_bodies.size())));
+  // A file-size limit on the process (`ulimit -f`, which Slurm passes on from the submitting
+  // shell) is a disk as small as the limit.
+  struct rlimit limit {};
+  if (getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+      bytes > static_cast<double>(limit.rlim_cur)) {
+    char text[256];
+    std::snprintf(text, sizeof text, ": the frames alone need about %.3g MB and the file-size limit (ulimit -f) is %.3g MB",
+                  bytes / 1e6, static_cast<double>(limit.rlim_cur) / 1e6);
+    throw OutputError(path_ + text + " (fewer frames: a larger run.output_every)");
+  }
   const std::filesystem::path dir = std::filesystem::absolute(path_).parent_path();
   struct statvfs fs {};
   if (statvfs(dir.c_str(), &fs) != 0) return;  // a missing directory is reported on creation
@@ -691,7 +777,7 @@ void Recorder::write_frame(double time, const BodyStates& state) {
     if (d.buffered_frames >= d.frame_chunk) d.flush();
   } catch (const H5::Exception& e) {
     impl_->write_failed = true;
-    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
+    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full? floedem run --resume continues it once there is room");
   }
 }
 
@@ -717,7 +803,7 @@ void Recorder::write_contacts(double time, std::span<const ContactRecord> contac
     if (d.k_time.size() >= 4096) d.flush();
   } catch (const H5::Exception& e) {
     impl_->write_failed = true;
-    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
+    throw OutputError(partial_path_ + ": write failed (" + e.getDetailMsg() + "); disk full? floedem run --resume continues it once there is room");
   }
 }
 
@@ -728,7 +814,7 @@ void Recorder::write_collisions(std::span<const CollisionRow> rows) {
     if (d.events.size() >= 1024) d.flush();
   } catch (const H5::Exception& e) {
     impl_->write_failed = true;
-    throw OutputError(partial_path_ + ": could not write collisions (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
+    throw OutputError(partial_path_ + ": could not write collisions (" + e.getDetailMsg() + "); disk full? floedem run --resume continues it once there is room");
   }
 }
 
@@ -821,7 +907,7 @@ void Recorder::finish(const std::vector<std::pair<std::string, double>>& summary
     d.closed = true;
   } catch (const H5::Exception& e) {
     impl_->write_failed = true;
-    throw OutputError(partial_path_ + ": could not complete the file (" + e.getDetailMsg() + "); disk full? The partial file may not be readable");
+    throw OutputError(partial_path_ + ": could not complete the file (" + e.getDetailMsg() + "); disk full? floedem run --resume continues it once there is room");
   }
   if (std::rename(partial_path_.c_str(), path_.c_str()) != 0)
     throw OutputError(partial_path_ + ": cannot rename to " + path_ + ": " + std::strerror(errno));

@@ -80,14 +80,16 @@ TEST_CASE("cli: an unwritable output exits 3", "[cli]") {
 TEST_CASE("cli: a disk that fills during the run exits 3, and nothing lies under the final name", "[cli]") {
   // A file-size limit (ulimit -f, which a batch system passes on from the submitting shell)
   // stands in for a full disk: floedem ignores the SIGXFSZ it sends, which would otherwise kill
-  // the run without a word (exit 153), so write() fails (EFBIG) as it would with ENOSPC. 2 MB
-  // holds the start of drift_in_floes (30 bodies, 3600 frames: ~5 MB). One line is all it
-  // prints: HDF5's destructors, closing the datasets the failed write left, said so a line each.
+  // the run without a word (exit 153), so write() fails (EFBIG) as it would with ENOSPC. 1.5 MB
+  // (3000 of dash's 512-byte blocks) is more than its frames alone need (1.05 MB, below which
+  // the run is refused before it starts) and holds the start of drift_in_floes (2.2 MB with its
+  // collision rows). One line is all it prints: HDF5's destructors, closing the datasets the
+  // failed write left, said so a line each.
   const fs::path d = fs::temp_directory_path() / ("floedem-full-" + std::to_string(::getpid()));
   fs::create_directories(d);
   const std::string scenario = std::string(FLOEDEM_SOURCE_DIR) + "/scenarios/drift_in_floes.toml";
   const fs::path out = d / "r.h5";
-  const Result r = floedem::test::run_cli("run " + scenario + " -q --out " + out.string(), "ulimit -f 2000; ");
+  const Result r = floedem::test::run_cli("run " + scenario + " -q --out " + out.string(), "ulimit -f 3000; ");
   INFO(r.output);
   CHECK(r.code == 3);
   CHECK(r.output.find("disk full?") != std::string::npos);
