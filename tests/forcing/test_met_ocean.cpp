@@ -8,6 +8,7 @@
 
 #include <netcdf.h>
 
+#include <algorithm>
 #include <complex>
 #include <fstream>
 #include <functional>
@@ -521,6 +522,13 @@ TEST_CASE("bad gridded forcing is refused with the file, the variable and what i
   CHECK_THROWS_AS(run_scene(s, o), InputError);
   CHECK_FALSE(std::filesystem::exists(o.output));
   CHECK_FALSE(std::filesystem::exists(o.output + ".partial"));
+  // And by `floedem check`, which reads the forcing at t = 0 as the first step does.
+  std::ofstream(dir / "hole.toml") << scene("hole.nc");
+  const auto checked = test::run_cli("check " + (dir / "hole.toml").string());
+  INFO(checked.output);
+  CHECK(checked.code == 2);
+  CHECK(checked.output.find("fill value") != std::string::npos);
+  CHECK(std::count(checked.output.begin(), checked.output.end(), '\n') == 1);
 }
 
 TEST_CASE("a gridded current with a depth axis feeds each keel layer the current at its depth",
