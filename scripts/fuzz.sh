@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Fuzzing: builds the libFuzzer targets of tests/fuzz with clang (address and undefined-
 # behaviour sanitizers on) in ./build-fuzz and runs each for SECONDS (default 60), starting
-# from the committed corpus in tests/fuzz/corpus. A crash, a hang (10 s per input), a failed
-# check or a sanitizer report fails the script; libFuzzer leaves the input as build-fuzz/crash-*.
+# from the committed corpus in tests/fuzz/corpus (the HDF5 images and the forcing files'
+# seeds are made here). A crash, a hang (10 s per input), 2 GB of memory, a failed check or a
+# sanitizer report fails the script; libFuzzer leaves the input as build-fuzz/crash-* (oom-*,
+# timeout-*).
 #   scripts/fuzz.sh [SECONDS]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -13,13 +15,16 @@ jobs="$(nproc 2>/dev/null || echo 2)"
 # -g1 (line tables): enough for file:line in a crash's stack trace, and a faster build than -g.
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DFLOEDEM_FUZZ=ON -DBUILD_TESTING=OFF >/dev/null
-cmake --build "$build" -j "$jobs" --target fuzz_scenario fuzz_contact fuzz_h5
+cmake --build "$build" -j "$jobs" --target fuzz_scenario fuzz_contact fuzz_h5 fuzz_inputs make_input_seeds
 cd "$build"
 # The HDF5 seeds are stored gzipped (tests/fuzz/make_h5_corpus.sh): unpacked here.
 rm -rf "$build/seed-h5"
 mkdir -p "$build/seed-h5"
 for f in "$root"/tests/fuzz/corpus/h5/*.h5.gz; do gunzip -c "$f" > "$build/seed-h5/$(basename "$f" .gz)"; done
-for target in scenario contact h5; do
+# The forcing files' and charts' seeds are written by netCDF-C and as text (make_input_seeds.cpp).
+rm -rf "$build/seed-inputs"
+"$build/make_input_seeds" "$build/seed-inputs"
+for target in scenario contact h5 inputs; do
   work="$build/corpus-$target"  # new inputs go here; the committed corpus is read only
   seeds="$root/tests/fuzz/corpus/$target"
   extra=()
@@ -28,6 +33,9 @@ for target in scenario contact h5; do
     # half (fuzz_h5.cpp); a cross-over of two images is nearly always no HDF5 file at all.
     seeds="$build/seed-h5"
     extra=(-cross_over=0 -max_len=2000000)
+  elif [[ $target == inputs ]]; then
+    seeds="$build/seed-inputs"
+    extra=(-max_len=65536)
   fi
   mkdir -p "$work"
   echo "fuzz: $target for $seconds s"

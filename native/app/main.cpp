@@ -18,8 +18,6 @@
 #include "app/python_script.hpp"
 #include "floedem/engine/registry.hpp"
 #include "floedem/engine/step_stages.hpp"
-#include "forcing/forcing.hpp"
-#include "towing/tow.hpp"
 #include "io/recorder.hpp"
 #include "floedem/run/resume.hpp"
 #include "floedem/run/simulation.hpp"
@@ -204,17 +202,9 @@ struct CheckCommand {
   int run() {
     const floedem::Scene scene = floedem::load_scenario(scenario, overrides);
     if (engines.empty()) engines.emplace_back("native");
-    std::unique_ptr<floedem::Engine> first;
-    for (const std::string& e : engines) {
-      auto made = floedem::make_engine(e, scene);
-      if (!first) first = std::move(made);
-    }
-    // The forcing at t = 0, read as a run's first step reads it: a grid's fill value or edge
-    // under a body's starting place is refused here too, not only once a run has begun.
-    floedem::Forcing forcing(scene);
-    const floedem::TowLine line(scene.tow);  // the tug's start and an unparted rope, as a run begins
-    forcing.attach_tow(line);
-    if (!forcing.empty()) (void)forcing.evaluate(first->state(), 0.0);
+    // Each engine built, and the forcing read where the bodies start, as a run's first step
+    // reads it: a grid's fill value or edge under a body is refused here too.
+    floedem::check_scene(scene, engines);
     std::cout << scenario << ": ok (" << scene.bodies.size() << " bodies, " << scene.run.steps() << " steps)\n";
     // The forcing that changes in time, and how much of the run each record covers (a record
     // that did not cover it was refused above).

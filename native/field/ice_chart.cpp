@@ -5,6 +5,7 @@
 #include <memory>
 #include <mutex>
 #include <numbers>
+#include <sstream>
 
 #include <cpl_error.h>
 #include <gdal_priv.h>
@@ -34,7 +35,7 @@ void register_drivers() {
 /// OGR's last message, or "" (GDAL reports through CPLError as well as return codes).
 std::string ogr_reason() {
   const char* m = CPLGetLastErrorMsg();
-  return (m && *m) ? std::string(" (") + m + ")" : std::string();
+  return (m && *m) ? " (" + printable(m, 200) + ")" : std::string();
 }
 
 /// A code attribute as an integer ("92", "09", "-9"); false where it is empty or not a number.
@@ -140,16 +141,16 @@ ChartPart part_of(const OGRPolygon& p) {
 void read_codes(OGRFeature& f, const int index[3], const std::string& where, ChartPolygon& poly) {
   std::string text;
   if (!read_code(f, index[0], poly.ct, text) || !sigrid3::concentration(poly.ct))
-    throw InputError(where + "attribute CT = '" + text + "' is not a SIGRID-3 total concentration; allowed " +
+    throw InputError(where + "attribute CT = '" + printable(text) + "' is not a SIGRID-3 total concentration; allowed " +
                      sigrid3::allowed("CT"));
   poly.concentration = *sigrid3::concentration(poly.ct);
   if (poly.concentration == 0.0) return;  // no ice: its stage and form are not read
   std::optional<sigrid3::CodeRange> stage, form;
   if (!read_code(f, index[1], poly.sa, text) || !(stage = sigrid3::thickness(poly.sa)))
-    throw InputError(where + "attribute SA = '" + text + "' is not a SIGRID-3 stage of development with a thickness; allowed " +
+    throw InputError(where + "attribute SA = '" + printable(text) + "' is not a SIGRID-3 stage of development with a thickness; allowed " +
                      sigrid3::allowed("SA"));
   if (!read_code(f, index[2], poly.fa, text) || !(form = sigrid3::floe_size(poly.fa)))
-    throw InputError(where + "attribute FA = '" + text + "' is not a SIGRID-3 form of ice of bounded floe size; allowed " +
+    throw InputError(where + "attribute FA = '" + printable(text) + "' is not a SIGRID-3 form of ice of bounded floe size; allowed " +
                      sigrid3::allowed("FA"));
   poly.thickness_min = stage->lo;
   poly.thickness_max = stage->hi;
@@ -174,16 +175,27 @@ std::unique_ptr<OGRCoordinateTransformation> to_wgs84(OGRLayer& layer, const std
   return ct;
 }
 
+/// GDAL's default handler prints each CPLError to stderr as it happens ("ERROR 1: Invalid
+/// Polygon object ..."), and so does GEOS through it; floedem reports one line of its own, with
+/// CPLGetLastErrorMsg as the reason, so the handler is quiet for as long as a chart is handled.
+struct QuietGdal {
+  QuietGdal() {
+    CPLErrorReset();
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+  }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+  QuietGdal(const QuietGdal&) = delete;
+  QuietGdal& operator=(const QuietGdal&) = delete;
+};
+
 }  // namespace
 
 IceChart read_ice_chart(const std::string& path, const std::string& layer_name, const GeoProjection& geo) {
+  const QuietGdal quiet;
   register_drivers();
   if (!OGRGeometryFactory::haveGEOS())
     throw InputError(path + ": this build's GDAL has no GEOS, which ice charts need to cut polygons");
-  CPLErrorReset();
-  CPLPushErrorHandler(CPLQuietErrorHandler);
   GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
-  CPLPopErrorHandler();
   if (!ds) throw InputError(path + ": cannot be opened as a vector file" + ogr_reason() + "; allowed a shapefile, GeoJSON or any file GDAL's OGR reads");
   OGRLayer* layer = layer_name.empty() ? (ds->GetLayerCount() > 0 ? ds->GetLayer(0) : nullptr)
                                        : ds->GetLayerByName(layer_name.c_str());
@@ -219,26 +231,36 @@ IceChart read_ice_chart(const std::string& path, const std::string& layer_name, 
     if (transform && g->transform(transform.get()) != OGRERR_NONE)
       throw InputError(where + "cannot be transformed to longitude and latitude" + ogr_reason());
     CPLErrorReset();
-    CPLPushErrorHandler(CPLQuietErrorHandler);
     const bool valid = g->IsValid();
-    CPLPopErrorHandler();
     if (!valid)
       throw InputError(where + "is not a valid polygon" + ogr_reason() +
                        "; allowed rings that do not cross themselves or each other, holes inside their outer ring");
-    g->segmentize(kMaxEdgeDeg);
     std::vector<const OGRPolygon*> pieces;
+    // The vertices are checked before the edges are cut into kMaxEdgeDeg pieces: a vertex at
+    // 1e7 deg would otherwise be cut into some 1e8 points before it could be refused.
+    collect_polygons(g.get(), pieces);
+    auto check_ring = [&](const OGRLinearRing& ring) {
+      for (int k = 0; k < ring.getNumPoints(); ++k)
+        if (!(std::abs(ring.getX(k)) <= 180.0 && std::abs(ring.getY(k)) <= 90.0)) {
+          std::ostringstream at;
+          at << "(" << ring.getX(k) << ", " << ring.getY(k) << ")";
+          throw InputError(where + "has a vertex at " + at.str() +
+                           ", not a longitude and latitude; allowed lon in [-180, 180], lat in [-90, 90] "
+                           "(or a file with its coordinate reference system)");
+        }
+    };
+    for (const OGRPolygon* p : pieces) {
+      check_ring(*p->getExteriorRing());
+      for (int k = 0; k < p->getNumInteriorRings(); ++k) check_ring(*p->getInteriorRing(k));
+    }
+    g->segmentize(kMaxEdgeDeg);
+    pieces.clear();
     collect_polygons(g.get(), pieces);
     for (const OGRPolygon* p : pieces) {
       ChartPart part;
       auto project = [&](const OGRLinearRing& ring) {
         std::vector<Vec2> out = ring_points(ring);
-        for (Vec2& v : out) {
-          if (!(std::abs(v.x) <= 180.0 && std::abs(v.y) <= 90.0))
-            throw InputError(where + "has a vertex at (" + std::to_string(v.x) + ", " + std::to_string(v.y) +
-                             "), not a longitude and latitude; allowed lon in [-180, 180], lat in [-90, 90] "
-                             "(or a file with its coordinate reference system)");
-          v = geo.to_plane({v.x, v.y});
-        }
+        for (Vec2& v : out) v = geo.to_plane({v.x, v.y});
         return out;
       };
       part.outer = project(*p->getExteriorRing());
@@ -339,6 +361,7 @@ std::uint64_t piece_seed(std::uint64_t seed, std::size_t polygon, std::size_t pi
 }  // namespace
 
 Field generate_chart_field(const IceChart& chart, const FieldSpec& base, std::vector<ChartPolygonStats>& stats) {
+  const QuietGdal quiet;
   const Vec2 lo = base.origin, hi = base.origin + Vec2{base.width, base.height};
   const auto rect = make_polygon({lo, {hi.x, lo.y}, hi, {lo.x, hi.y}});
   std::vector<std::unique_ptr<OGRPolygon>> zones;

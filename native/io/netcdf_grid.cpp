@@ -142,6 +142,12 @@ Axis read_axis(int nc, int dim, const std::string& path, const std::string& vari
   int ndims = 0;
   nc_inq_varndims(nc, a.var, &ndims);
   if (ndims != 1) fail(path, a.name, "coordinate variable of " + std::to_string(ndims) + " dimensions; allowed 1");
+  // CF's coordinate variable lies over the dimension it names: one over another dimension would be read
+  // past the values sized for this one.
+  int own = -1;
+  nc_inq_vardimid(nc, a.var, &own);
+  if (own != dim)
+    fail(path, a.name, "coordinate variable over another dimension; allowed one over its own dimension '" + a.name + "'");
   a.values.resize(len);
   if (len > 0 && nc_get_var_double(nc, a.var, a.values.data()) != NC_NOERR)
     fail(path, a.name, "cannot read the coordinate variable");
@@ -177,7 +183,7 @@ FlowGridSpec inspect_flow_grid(const std::string& path, const std::string& u, co
       fail(path, names[c], "no such variable; allowed the name of the file's variable (the scenario's u and v)");
     const std::string units = text_attribute(nc, ids[c], "units");
     if (!is_velocity_unit(units))
-      fail(path, names[c] + ".units", "'" + units + "' is not a velocity; allowed m s-1 (or m/s)");
+      fail(path, names[c] + ".units", "'" + printable(units) + "' is not a velocity; allowed m s-1 (or m/s)");
     nc_inq_varndims(nc, ids[c], &ndims[c]);
     if (ndims[c] != 3 && ndims[c] != 4)
       fail(path, names[c], std::to_string(ndims[c]) + " dimensions; allowed (time, y, x) or (time, depth, y, x)");
@@ -192,11 +198,11 @@ FlowGridSpec inspect_flow_grid(const std::string& path, const std::string& u, co
   // Time: against the run's start.
   double per_unit = 0.0, epoch = 0.0;
   if (!parse_time_units(time.units, per_unit, epoch))
-    fail(path, time.name + ".units", "'" + time.units + "' is not a time axis; allowed \"<seconds|minutes|hours|" +
+    fail(path, time.name + ".units", "'" + printable(time.units) + "' is not a time axis; allowed \"<seconds|minutes|hours|" +
                                          "days> since YYYY-MM-DD hh:mm:ss\" in UTC (the first dimension is time)");
   const std::string calendar = lower(text_attribute(nc, time.var, "calendar"));
   if (!(calendar.empty() || calendar == "standard" || calendar == "gregorian" || calendar == "proleptic_gregorian"))
-    fail(path, time.name + ".calendar", "'" + calendar + "'; allowed standard, gregorian or proleptic_gregorian");
+    fail(path, time.name + ".calendar", "'" + printable(calendar) + "'; allowed standard, gregorian or proleptic_gregorian");
   if (run.start.empty())
     fail(path, time.name, "a dated time axis needs the run's start; allowed a scenario with [run] start");
   for (double t : time.values) spec.time.push_back(t * per_unit + (epoch - run.start_unix));
@@ -210,13 +216,13 @@ FlowGridSpec inspect_flow_grid(const std::string& path, const std::string& u, co
   const bool lonlat = is_geographic_unit(x.units) || is_geographic_unit(y.units);
   for (const Axis* a : {&x, &y}) {
     if (lonlat && !geo.present)
-      fail(path, a->name + ".units", "'" + a->units + "': longitude and latitude need a geographic scene ([geo]); " +
+      fail(path, a->name + ".units", "'" + printable(a->units) + "': longitude and latitude need a geographic scene ([geo]); " +
                                          "allowed x and y in m, the scene's own coordinates, without one");
     if (lonlat && a == &x && !is_longitude_unit(a->units))
-      fail(path, a->name + ".units", "'" + a->units + "'; allowed degrees_east (the last dimension is longitude)");
+      fail(path, a->name + ".units", "'" + printable(a->units) + "'; allowed degrees_east (the last dimension is longitude)");
     if (lonlat && a == &y && !is_latitude_unit(a->units))
-      fail(path, a->name + ".units", "'" + a->units + "'; allowed degrees_north (the last but one is latitude)");
-    if (!lonlat && !is_length_unit(a->units)) fail(path, a->name + ".units", "'" + a->units + "'; allowed m");
+      fail(path, a->name + ".units", "'" + printable(a->units) + "'; allowed degrees_north (the last but one is latitude)");
+    if (!lonlat && !is_length_unit(a->units)) fail(path, a->name + ".units", "'" + printable(a->units) + "'; allowed m");
     if (a->values.size() < 2) fail(path, a->name, "fewer than 2 points; allowed a grid of at least 2 x 2");
   }
   if (lonlat) {  // the plane's lattice comes once the bodies are known (place_lonlat_grid)
@@ -233,7 +239,7 @@ FlowGridSpec inspect_flow_grid(const std::string& path, const std::string& u, co
   }
   if (n == 4) {
     Axis z = read_axis(nc, dims[0][1], path, u);
-    if (!is_length_unit(z.units)) fail(path, z.name + ".units", "'" + z.units + "'; allowed m (depth)");
+    if (!is_length_unit(z.units)) fail(path, z.name + ".units", "'" + printable(z.units) + "'; allowed m (depth)");
     if (lower(text_attribute(nc, z.var, "positive")) == "up")
       fail(path, z.name + ".positive", "\"up\"; allowed a depth axis positive down (depths that increase downward)");
     spec.depth = z.values;
@@ -316,6 +322,13 @@ void NetcdfSlices::read_one(const Variable& var, std::size_t k, std::vector<doub
     // A fill value is compared as stored (before unpacking), as CF defines it.
     const bool missing = !std::isfinite(x) || std::find(var.fill.begin(), var.fill.end(), x) != var.fill.end();
     x = missing ? std::nan("") : var.scale * x + var.offset;
+    if (std::abs(x) > kMaxFlowComponent) {
+      std::ostringstream value;
+      value << x;
+      fail(spec_.file, &var == &u_ ? spec_.u : spec_.v,
+           value.str() + " m/s in time slice " + std::to_string(k) +
+               " is not a wind or current speed; allowed [-100, 100] m/s or a fill value");
+    }
   }
 }
 

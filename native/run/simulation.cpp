@@ -12,9 +12,12 @@
 #include <sstream>
 
 #include "contacts/contact_loads.hpp"
+#include "floedem/engine/registry.hpp"
+#include "forcing/forcing.hpp"
 #include "io/recorder.hpp"
 #include "run/energy_balance.hpp"
 #include "run/stepper.hpp"
+#include "towing/tow.hpp"
 #include "floedem/scene/input_error.hpp"
 #include "floedem/version.hpp"
 
@@ -166,7 +169,13 @@ class SceneRun {
       summary_.kinetic_energy_start = kinetic_energy(scene_, stepper_.state());
       summary_.max_kinetic_energy = summary_.kinetic_energy_start;
       constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-      if (tow_.active()) recorder_->write_tow(0.0, {{nan, nan}, {nan, nan}, {nan, nan}, tow_.tug_position(0.0)});  // no step yet
+      if (tow_.active()) {
+        TowFrame first;  // no step yet: no forces
+        first.force = first.force_mean = first.ice_force_mean = {nan, nan};
+        first.tug_position = tow_.tug_position(0.0);
+        first.tug_velocity = tow_.line().tug_velocity(scene_.tow, scene_.has_environment ? &scene_.environment : nullptr, 0.0);
+        recorder_->write_tow(0.0, first);
+      }
       write_frame(0.0);
       return 1;
     }
@@ -398,6 +407,18 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   }
   progress.done();
   return run.finish(start);
+}
+
+void check_scene(const Scene& scene, const std::vector<std::string>& engines) {
+  std::unique_ptr<Engine> first;
+  for (const std::string& e : engines.empty() ? std::vector<std::string>{"native"} : engines) {
+    auto made = make_engine(e, scene);
+    if (!first) first = std::move(made);
+  }
+  Forcing forcing(scene);
+  const TowLine line(scene.tow);  // the tug's start and an unparted rope, as a run begins
+  forcing.attach_tow(line);
+  if (!forcing.empty()) (void)forcing.evaluate(first->state(), 0.0);
 }
 
 std::string format_summary(const Scene& scene, const RunSummary& s, const std::string& output) {

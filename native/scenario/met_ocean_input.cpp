@@ -133,14 +133,17 @@ bool read_velocity_file(TableReader& env, std::string_view key, Scene& scene, Ve
       value[j] = std::strtod(cell.c_str(), &end);
       if (cell.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(value[j]))
         throw InputError(input_message(name, number, names[j],
-                                       "'" + cell + "' is not a number; allowed a finite number (" +
+                                       "'" + printable(cell) + "' is not a number; allowed a finite number (" +
                                            (j == 0 ? "s from the run's start)" : "m/s)")));
     }
-    if (!series.time.empty() && !(value[0] > series.time.back()))
+    if (!series.time.empty() && !(value[0] > series.time.back())) {
+      std::ostringstream above;
+      above << series.time.back();
       throw InputError(input_message(name, number, "time", "times must increase; allowed a value above " +
-                                                               std::to_string(series.time.back()) + " s"));
-    if (std::abs(value[1]) > 100.0 || std::abs(value[2]) > 100.0)
-      throw InputError(input_message(name, number, std::abs(value[1]) > 100.0 ? u_name : v_name,
+                                                               above.str() + " s"));
+    }
+    if (std::abs(value[1]) > kMaxFlowComponent || std::abs(value[2]) > kMaxFlowComponent)
+      throw InputError(input_message(name, number, std::abs(value[1]) > kMaxFlowComponent ? u_name : v_name,
                                      "is not a wind or current speed; allowed [-100, 100] m/s"));
     series.time.push_back(value[0]);
     series.velocity.push_back({value[1], value[2]});

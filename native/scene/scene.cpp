@@ -1,5 +1,6 @@
 #include "floedem/scene/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -8,6 +9,44 @@
 #include "floedem/scene/input_error.hpp"
 
 namespace floedem {
+
+std::string printable(std::string_view text, std::size_t max) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    if (k == max) {
+      out += "...";
+      break;
+    }
+    const auto c = static_cast<unsigned char>(text[k]);
+    if (c >= 0x20 && c < 0x7f) {
+      out.push_back(static_cast<char>(c));
+    } else {
+      out += "\\x";
+      out.push_back(kHex[c >> 4]);
+      out.push_back(kHex[c & 15]);
+    }
+  }
+  return out;
+}
+
+std::string one_line(const std::string& message) {
+  if (std::none_of(message.begin(), message.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+    return message;
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (char ch : message) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7f) {
+      out += "\\x";
+      out.push_back(kHex[c >> 4]);
+      out.push_back(kHex[c & 15]);
+    } else {
+      out.push_back(ch);
+    }
+  }
+  return out;
+}
 
 std::string input_message(const std::string& file, std::uint32_t line, const std::string& field,
                           const std::string& what) {

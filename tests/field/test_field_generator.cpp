@@ -299,3 +299,21 @@ TEST_CASE("field: no floe a keep-out cut leaves smaller than d_min", "[field]") 
   for (const auto& p : f.floes) REQUIRE(signed_area(p) >= smallest * (1.0 - 1e-9));
   CHECK(std::abs(f.stats.concentration - 0.4) <= 0.005);
 }
+
+TEST_CASE("field: a keep-out zone cut by the domain's edge is refused by name when its pockets cannot be filled",
+          "[field][input]") {
+  // The towing case's iceberg with the domain's top edge across its notch (y = 50 m): the edge
+  // closes off water between the notch and the edge. For most seeds no weights fill the cells
+  // there; that must be a refusal naming the zone, never the generator's internal error.
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    FieldSpec s = round_iceberg({-150.0, -350.0}, 1500.0, 400.0, 0.5, seed);
+    s.keep_out_names = {"body 'iceberg'"};
+    try {
+      const Field f = generate_field(s);
+      CHECK(f.stats.max_cell_area_error <= 1e-3);
+    } catch (const FieldSpecError& e) {
+      CHECK(e.parameter() == "keep_out[0]");
+      CHECK_THAT(e.what(), Catch::StartsWith("body 'iceberg' crosses the domain's edge"));
+    }
+  }
+}

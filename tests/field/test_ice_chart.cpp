@@ -255,6 +255,11 @@ TEST_CASE("Bad charts are refused with the file, the feature and the attribute",
   auto bowtie = three_polygons();
   bowtie[0].ring = {{14.98, 75.99}, {15.0, 76.01}, {15.0, 75.99}, {14.98, 76.01}};
   refused(bowtie, "feature 0: is not a valid polygon");
+  // A vertex far off the globe (a mangled coordinate) is refused before the edges are cut into
+  // short pieces for the projection, which would make some 1e9 points of it.
+  auto far = three_polygons();
+  far[0].ring = {{14.98, 75.99}, {1.5e7, 75.99}, {14.98, 76.01}};
+  refused(far, "feature 0: has a vertex at (1.5e+07, 75.99), not a longitude and latitude; allowed lon in [-180, 180]");
   auto overlapping = three_polygons();
   overlapping[1].ring = {{14.99, 75.99}, {15.02, 75.99}, {15.02, 76.01}, {14.99, 76.01}};
   refused(overlapping, "features 0 and 1 overlap");

@@ -302,15 +302,16 @@ struct GridFile {
   std::string velocity_units = "m s-1", x_units = "m", time_units = "hours since 2024-03-01 00:00:00";
   std::string y_units;  // empty: x_units
   bool fill_somewhere = false;  // the first cell of every slice holds the fill value
+  bool x_over_time = false;     // the variable x lies over the time dimension (not CF)
 };
 
 void write_grid(const std::filesystem::path& path, const GridFile& g) {
   int nc = -1;
   REQUIRE(nc_create(path.c_str(), NC_CLOBBER | NC_NETCDF4, &nc) == NC_NOERR);
-  auto dim = [&](const char* name, const std::vector<double>& values, const std::string& units) {
+  auto dim = [&](const char* name, const std::vector<double>& values, const std::string& units, int over = -1) {
     int d = -1, v = -1;
     nc_def_dim(nc, name, values.size(), &d);
-    nc_def_var(nc, name, NC_DOUBLE, 1, &d, &v);
+    nc_def_var(nc, name, NC_DOUBLE, 1, over < 0 ? &d : &over, &v);
     nc_put_att_text(nc, v, "units", units.size(), units.c_str());
     return std::pair{d, v};
   };
@@ -318,7 +319,7 @@ void write_grid(const std::filesystem::path& path, const GridFile& g) {
   const bool z = !g.depth.empty();
   const auto d = z ? dim("depth", g.depth, "m") : std::pair{-1, -1};
   const auto y = dim("y", g.y, g.y_units.empty() ? g.x_units : g.y_units);
-  const auto x = dim("x", g.x, g.x_units);
+  const auto x = dim("x", g.x, g.x_units, g.x_over_time ? t.first : -1);
   std::vector<int> dims = {t.first};
   if (z) dims.push_back(d.first);
   dims.push_back(y.first);
@@ -335,7 +336,7 @@ void write_grid(const std::filesystem::path& path, const GridFile& g) {
   nc_put_var_double(nc, t.second, g.time.data());
   if (z) nc_put_var_double(nc, d.second, g.depth.data());
   nc_put_var_double(nc, y.second, g.y.data());
-  nc_put_var_double(nc, x.second, g.x.data());
+  nc_put_var_double(nc, x.second, (g.x_over_time ? g.time : g.x).data());
   std::vector<float> us, vs;
   const std::vector<double> levels = z ? g.depth : std::vector<double>{0.0};
   for (double time : g.time)
@@ -494,6 +495,12 @@ TEST_CASE("bad gridded forcing is refused with the file, the variable and what i
     g.x_units = "degrees_east";
     write_grid(dir / "geo.nc", g);
     cases.push_back({"longitude", scene("geo.nc"), {"geo.nc", "'x.units'", "geographic"}});
+    g = base();
+    g.time = {0.0, 0.5, 1.0, 1.5};  // longer than x: read over x's two values, it would overflow them
+    g.x_over_time = true;
+    write_grid(dir / "x-over-time.nc", g);
+    cases.push_back({"coordinate over another dimension", scene("x-over-time.nc"),
+                     {"x-over-time.nc", "'x'", "over another dimension", "its own dimension 'x'"}});
     std::ofstream(dir / "text.nc") << "not netcdf\n";
     cases.push_back({"not netcdf", scene("text.nc"), {"text.nc", "'file'", "cannot open as NetCDF"}});
   }
@@ -522,13 +529,40 @@ TEST_CASE("bad gridded forcing is refused with the file, the variable and what i
   CHECK_THROWS_AS(run_scene(s, o), InputError);
   CHECK_FALSE(std::filesystem::exists(o.output));
   CHECK_FALSE(std::filesystem::exists(o.output + ".partial"));
-  // And by `floedem check`, which reads the forcing at t = 0 as the first step does.
+  // And by the library's check_scene and `floedem check`, which read the forcing at t = 0 as
+  // the first step does.
+  CHECK_THROWS_AS(check_scene(s), InputError);
   std::ofstream(dir / "hole.toml") << scene("hole.nc");
   const auto checked = test::run_cli("check " + (dir / "hole.toml").string());
   INFO(checked.output);
   CHECK(checked.code == 2);
   CHECK(checked.output.find("fill value") != std::string::npos);
   CHECK(std::count(checked.output.begin(), checked.output.end(), '\n') == 1);
+}
+
+TEST_CASE("a grid value beyond any wind or current is refused before the run", "[input][met_ocean]") {
+  // A flipped exponent byte turns 0.1 m/s into 1e38 m/s; driven into a run it would fling the
+  // floes, so the slice is refused where it is read, and `floedem check` reads it at t = 0.
+  const std::filesystem::path dir = test::temp_dir("grid-fast");
+  GridFile g;
+  g.x = {-100.0, 100.0};
+  g.y = {-100.0, 100.0};
+  g.time = {0.0, 1.0};
+  g.field = [](double, double x, double, double) { return Vec2{x > 0.0 ? 3.0e4 : 0.1, 0.0}; };
+  write_grid(dir / "fast.nc", g);
+  std::ofstream(dir / "fast.toml")
+      << std::string(kStart) + "duration = 3600.0\ndt = 1.0\n[environment]\n" + grid_table(dir / "fast.nc") +
+             "[[body]]\nname = \"a\"\npolygon = [[0,0],[10,0],[10,10],[0,10]]\nthickness = 1.0\n";
+  const auto checked = test::run_cli("check " + (dir / "fast.toml").string());
+  INFO(checked.output);
+  CHECK(checked.code == 2);
+  CHECK(std::count(checked.output.begin(), checked.output.end(), '\n') == 1);
+  for (const char* s : {"fast.nc", "'uo'", "30000 m/s", "time slice 0", "[-100, 100] m/s"})
+    CHECK(checked.output.find(s) != std::string::npos);
+  const auto ran = test::run_cli("run " + (dir / "fast.toml").string() + " --out " + (dir / "fast.h5").string() + " --quiet");
+  CHECK(ran.code == 2);
+  CHECK_FALSE(std::filesystem::exists(dir / "fast.h5"));
+  CHECK_FALSE(std::filesystem::exists(dir / "fast.h5.partial"));
 }
 
 TEST_CASE("a gridded current with a depth axis feeds each keel layer the current at its depth",

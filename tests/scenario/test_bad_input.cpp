@@ -147,6 +147,18 @@ TEST_CASE("clockwise polygons are accepted by reversing them", "[input]") {
   CHECK(s.bodies[0].mass == Approx(900.0));
 }
 
+TEST_CASE("a refusal stays on one line whatever value it quotes", "[input]") {
+  // TOML strings hold newlines; a damaged forcing file's attributes hold any bytes.
+  const std::string m = error_of(kRun + "[contact]\nforce_model = \"linear\\nquadratic\"\n" + kBody);
+  INFO(m);
+  CHECK(m.find('\n') == std::string::npos);
+  CHECK(m.find("\"linear\\x0aquadratic\"") != std::string::npos);
+  CHECK(one_line("a\tb\r\n") == "a\\x09b\\x0d\\x0a");
+  CHECK(printable("m s-1") == "m s-1");
+  CHECK(printable(std::string("\x01\xff\n", 3)) == "\\x01\\xff\\x0a");
+  CHECK(printable(std::string(100, 'x'), 10) == "xxxxxxxxxx...");
+}
+
 TEST_CASE("touching bodies are not an overlap", "[input]") {
   const Scene s = test::scene_from(kRun + kBody +
                                    "[[body]]\nname = \"b\"\npolygon = [[1,0],[2,0],[2,1],[1,1]]\nthickness = 1\n");

@@ -74,6 +74,13 @@ struct RunSummary {
 /// file is made), OutputError, SolverFailure.
 RunSummary run_scene(const Scene& scene, const RunOptions& options);
 
+/// What a run finds before its first step, found without running it (`floedem check`): the
+/// scene built on each engine (InputError for engine settings out of range) and the forcing
+/// read at t = 0 on the first engine's starting state with the tow line as a run begins, as the
+/// first step reads it (InputError for a grid's fill value or edge under a body's starting
+/// place). Writes nothing. `engines` empty: native.
+void check_scene(const Scene& scene, const std::vector<std::string>& engines = {});
+
 /// Multi-line human summary.
 std::string format_summary(const Scene& scene, const RunSummary& s, const std::string& output);
 

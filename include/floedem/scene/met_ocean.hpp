@@ -33,6 +33,11 @@ double tidal_period(const std::string& name);
 /// The standard names, in the order tidal_period knows them.
 const std::vector<std::string>& tidal_constituent_names();
 
+/// The largest wind or current component (m/s) a record or grid may hold: far above any
+/// sustained surface wind or ocean current on record, so that a misread value (a flipped byte,
+/// a unit slip such as cm/s written as m/s) is refused rather than driven into a run.
+inline constexpr double kMaxFlowComponent = 100.0;
+
 /// A velocity (m/s) against time (s from the run's start), linear between its samples: a wind
 /// or current record read from a CSV file (scenario.cpp checks that it covers the run).
 struct VelocitySeries {
