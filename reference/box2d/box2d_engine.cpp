@@ -32,13 +32,11 @@ struct Box2dSettings {
 
 Box2dSettings read_settings(const Scene& scene) {
   Box2dSettings s;
-  const auto it = scene.engine_settings.find("box2d");
-  if (it == scene.engine_settings.end()) return s;
-  TableReader r(it->second, scene.source_path, "engine.box2d");
-  s.velocity_iterations = static_cast<int>(r.integer("velocity_iterations", s.velocity_iterations, 1, 100000));
-  s.position_iterations = static_cast<int>(r.integer("position_iterations", s.position_iterations, 0, 100000));
-  s.polygon_radius = r.real("polygon_radius", s.polygon_radius, Range::non_negative());
-  r.reject_unknown();
+  reference::read_settings(scene, "box2d", [&](TableReader& r) {
+    s.velocity_iterations = static_cast<int>(r.integer("velocity_iterations", s.velocity_iterations, 1, 100000));
+    s.position_iterations = static_cast<int>(r.integer("position_iterations", s.position_iterations, 0, 100000));
+    s.polygon_radius = r.real("polygon_radius", s.polygon_radius, Range::non_negative());
+  });
   return s;
 }
 
@@ -187,19 +185,10 @@ void Box2dEngine::PostSolve(b2Contact* contact, const b2ContactImpulse* impulse)
   for (int k = 0; k < count; ++k) {
     const double pn = impulse->normalImpulses[k], pt = impulse->tangentImpulses[k];
     if (pn == 0.0 && pt == 0.0) continue;
-    // floedem's convention: a < b, normal from a to b, impulses on b.
-    const bool flip = ia > ib;
-    const Vec2 normal = flip ? -n : n;
-    const Vec2 on_b = (flip ? -1.0 : 1.0) * (pn * n + pt * t);
-    ContactRecord r;
-    r.body_a = flip ? ib : ia;
-    r.body_b = flip ? ia : ib;
-    r.point = origin_ + Vec2{wm.points[k].x, wm.points[k].y};
-    r.normal = normal;
-    r.normal_impulse = dot(on_b, normal);
-    r.tangent_impulse = dot(on_b, perp(normal));
+    // Box2D: the normal from A to B, the impulses on B.
+    ContactRecord r = reference::oriented_record(ia, ib, origin_ + Vec2{wm.points[k].x, wm.points[k].y}, n,
+                                                 pn * n + pt * t, wm.separations[k]);
     r.approach_velocity = found ? (*found)[k] : 0.0;
-    r.separation = wm.separations[k];
     r.kind = r.approach_velocity < -threshold_ ? ContactKind::collision : ContactKind::resting;
     records_.push_back(r);
   }

@@ -45,13 +45,11 @@ struct BulletSettings {
 
 BulletSettings read_settings(const Scene& scene) {
   BulletSettings s;
-  const auto it = scene.engine_settings.find("bullet");
-  if (it == scene.engine_settings.end()) return s;
-  TableReader r(it->second, scene.source_path, "engine.bullet");
-  s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
-  s.margin = r.real("margin", s.margin, Range::positive());
-  s.compliant = r.string("contact_model", "impulse", {"impulse", "compliant"}) == "compliant";
-  r.reject_unknown();
+  reference::read_settings(scene, "bullet", [&](TableReader& r) {
+    s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
+    s.margin = r.real("margin", s.margin, Range::positive());
+    s.compliant = r.string("contact_model", "impulse", {"impulse", "compliant"}) == "compliant";
+  });
   return s;
 }
 
@@ -269,23 +267,15 @@ void BulletEngine::collect_contacts() {
     for (int j = 0; j < pm->getNumContacts(); ++j) {
       const btManifoldPoint& pt = pm->getContactPoint(j);
       if (pt.getDistance() > 0) continue;  // not solved this step: its impulse is stale
-      // Bullet pushes body 0 along m_normalWorldOnB.
+      // Bullet pushes body 0 along m_normalWorldOnB: the normal from body 0 towards body 1 is
+      // its opposite, and body 1 takes the opposite of body 0's impulse.
       const btVector3 on0 = pt.m_appliedImpulse * pt.m_normalWorldOnB + pt.m_appliedImpulseLateral1 * pt.m_lateralFrictionDir1 +
                             pt.m_appliedImpulseLateral2 * pt.m_lateralFrictionDir2;
       if (on0.length2() == 0) continue;
-      const bool flip = i0 > i1;  // floedem: a < b, normal from a to b, impulse on b
       const Vec2 n0{pt.m_normalWorldOnB.x(), pt.m_normalWorldOnB.y()};
-      const Vec2 normal = normalized(flip ? n0 : -n0);  // from body 0 towards body 1 is -n0
-      const Vec2 on_b = flip ? Vec2{on0.x(), on0.y()} : Vec2{-on0.x(), -on0.y()};
-      ContactRecord r;
-      r.body_a = flip ? i1 : i0;
-      r.body_b = flip ? i0 : i1;
       const btVector3 p = 0.5 * (pt.getPositionWorldOnA() + pt.getPositionWorldOnB());
-      r.point = {p.x(), p.y()};
-      r.normal = normal;
-      r.normal_impulse = dot(on_b, normal);
-      r.tangent_impulse = dot(on_b, perp(normal));
-      r.separation = pt.getDistance();
+      ContactRecord r = reference::oriented_record(i0, i1, {p.x(), p.y()}, normalized(-n0), Vec2{-on0.x(), -on0.y()},
+                                                   pt.getDistance());
       reference::classify(r, before_, threshold_);
       records_.push_back(r);
     }

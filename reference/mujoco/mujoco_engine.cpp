@@ -69,30 +69,28 @@ struct MujocoSettings {
 
 MujocoSettings read_settings(const Scene& scene) {
   MujocoSettings s;
-  const auto it = scene.engine_settings.find("mujoco");
-  if (it == scene.engine_settings.end()) return s;
-  TableReader r(it->second, scene.source_path, "engine.mujoco");
-  s.solver = r.string("solver", s.solver, {"newton", "cg", "pgs"});
-  s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
-  s.tolerance = r.real("tolerance", s.tolerance, Range::non_negative());
-  s.cone = r.string("cone", s.cone, {"elliptic", "pyramidal"});
-  s.multiccd = r.boolean("multiccd", s.multiccd);
-  if (r.has("substeps")) s.substeps = static_cast<int>(r.integer("substeps", std::nullopt, 1, 100000));
-  if (r.has("solref")) {
-    s.scene_solref = false;
-    s.solref = r.vec2("solref", std::nullopt);
-    // MuJoCo's two forms: (time constant, damping ratio), both positive, or (-stiffness,
-    // -damping) in acceleration units, the stiffness negative and the damping not positive.
-    const bool timeconst = s.solref.x > 0 && s.solref.y > 0, direct = s.solref.x < 0 && s.solref.y <= 0;
-    if (!timeconst && !direct)
-      r.fail("solref", "allowed [timeconst > 0, dampratio > 0] or [-stiffness < 0, -damping <= 0], got [" +
-                           setting_text(s.solref.x) + ", " + setting_text(s.solref.y) + "]");
-  }
-  // MuJoCo's impedance limits (mjMINIMP, mjMAXIMP): d = 0 would make a row inert, d = 1 hard.
-  const Range impedance = Range::closed(1e-4, 0.9999);
-  s.solimp = r.reals("solimp", s.solimp, {impedance, impedance, Range::positive(), Range::closed(0.0, 1.0), Range::closed(1.0, 1e3)});
-  if (r.has("max_contacts")) s.max_contacts = static_cast<int>(r.integer("max_contacts", std::nullopt, 1, 10000000));
-  r.reject_unknown();
+  reference::read_settings(scene, "mujoco", [&](TableReader& r) {
+    s.solver = r.string("solver", s.solver, {"newton", "cg", "pgs"});
+    s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
+    s.tolerance = r.real("tolerance", s.tolerance, Range::non_negative());
+    s.cone = r.string("cone", s.cone, {"elliptic", "pyramidal"});
+    s.multiccd = r.boolean("multiccd", s.multiccd);
+    if (r.has("substeps")) s.substeps = static_cast<int>(r.integer("substeps", std::nullopt, 1, 100000));
+    if (r.has("solref")) {
+      s.scene_solref = false;
+      s.solref = r.vec2("solref", std::nullopt);
+      // MuJoCo's two forms: (time constant, damping ratio), both positive, or (-stiffness,
+      // -damping) in acceleration units, the stiffness negative and the damping not positive.
+      const bool timeconst = s.solref.x > 0 && s.solref.y > 0, direct = s.solref.x < 0 && s.solref.y <= 0;
+      if (!timeconst && !direct)
+        r.fail("solref", "allowed [timeconst > 0, dampratio > 0] or [-stiffness < 0, -damping <= 0], got [" +
+                             setting_text(s.solref.x) + ", " + setting_text(s.solref.y) + "]");
+    }
+    // MuJoCo's impedance limits (mjMINIMP, mjMAXIMP): d = 0 would make a row inert, d = 1 hard.
+    const Range impedance = Range::closed(1e-4, 0.9999);
+    s.solimp = r.reals("solimp", s.solimp, {impedance, impedance, Range::positive(), Range::closed(0.0, 1.0), Range::closed(1.0, 1e3)});
+    if (r.has("max_contacts")) s.max_contacts = static_cast<int>(r.integer("max_contacts", std::nullopt, 1, 10000000));
+  });
   return s;
 }
 
@@ -422,17 +420,8 @@ void MujocoEngine::collect_contacts() {
     const Vec2 on2{f[0] * fr[0] + f[1] * fr[3] + f[2] * fr[6], f[0] * fr[1] + f[1] * fr[4] + f[2] * fr[7]};
     if (on2.x == 0.0 && on2.y == 0.0) continue;
     const std::int32_t g1 = body_of_geom_[static_cast<std::size_t>(k.geom1)], g2 = body_of_geom_[static_cast<std::size_t>(k.geom2)];
-    const bool flip = g1 > g2;  // floedem: a < b, normal from a to b, impulse on b
-    const Vec2 n12 = normalized(Vec2{fr[0], fr[1]});
-    ContactRecord r;
-    r.body_a = flip ? g2 : g1;
-    r.body_b = flip ? g1 : g2;
-    r.normal = flip ? -n12 : n12;
-    const Vec2 on_b = flip ? -h_ * on2 : h_ * on2;
-    r.point = {k.pos[0], k.pos[1]};
-    r.normal_impulse = dot(on_b, r.normal);
-    r.tangent_impulse = dot(on_b, perp(r.normal));
-    r.separation = k.dist;
+    ContactRecord r =
+        reference::oriented_record(g1, g2, {k.pos[0], k.pos[1]}, normalized(Vec2{fr[0], fr[1]}), h_ * on2, k.dist);
     reference::classify(r, before_, contact_.collision_threshold);
     records_.push_back(r);
   }

@@ -47,16 +47,14 @@ struct OdeSettings {
 
 OdeSettings read_settings(const Scene& scene) {
   OdeSettings s;
-  const auto it = scene.engine_settings.find("ode");
-  if (it == scene.engine_settings.end()) return s;
-  TableReader r(it->second, scene.source_path, "engine.ode");
-  s.quick_step = r.string("step", "quick", {"quick", "world"}) == "quick";
-  s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
-  s.cfm = r.real("cfm", s.cfm, Range::non_negative());
-  s.erp = r.real("erp", s.erp, Range::closed(0.0, 1.0));
-  s.max_correcting_velocity = r.real("max_correcting_velocity", s.max_correcting_velocity, Range::non_negative());
-  s.compliant = r.string("contact_model", "impulse", {"impulse", "compliant"}) == "compliant";
-  r.reject_unknown();
+  reference::read_settings(scene, "ode", [&](TableReader& r) {
+    s.quick_step = r.string("step", "quick", {"quick", "world"}) == "quick";
+    s.iterations = static_cast<int>(r.integer("iterations", s.iterations, 1, 100000));
+    s.cfm = r.real("cfm", s.cfm, Range::non_negative());
+    s.erp = r.real("erp", s.erp, Range::closed(0.0, 1.0));
+    s.max_correcting_velocity = r.real("max_correcting_velocity", s.max_correcting_velocity, Range::non_negative());
+    s.compliant = r.string("contact_model", "impulse", {"impulse", "compliant"}) == "compliant";
+  });
   return s;
 }
 
