@@ -92,7 +92,8 @@ void TensionHistogram::restore(StateReader& in) {
     throw StateError("checkpoint: the tow's tension histogram has another size");
 }
 
-TowMonitor::TowMonitor(const Scene& scene) : scene_(scene), tow_(scene.tow), line_(scene.tow) {}
+TowMonitor::TowMonitor(const Scene& scene)
+    : scene_(scene), tow_(scene.tow), direction_(scene.tow.direction()), line_(scene.tow) {}
 
 Vec2 TowMonitor::tug_position(double time) const {
   if (tow_.has_rope()) return line_.tug_position(tow_, time);
@@ -145,7 +146,7 @@ void TowMonitor::after_step(const BodyStates& state, std::span<const ContactReco
     const EnvironmentSpec* water = scene_.has_environment ? &scene_.environment : nullptr;
     line_.tug += dt * line_.tug_velocity(tow_, water, time_);
   }
-  if (dot(state.velocity[tow_.body], tow_.direction()) < tow_.stall_speed) stalled_time_ += dt;
+  if (dot(state.velocity[tow_.body], direction_) < tow_.stall_speed) stalled_time_ += dt;
   sum_ += force_;
   ice_sum_ += ice_;
   ++count_;
@@ -153,7 +154,7 @@ void TowMonitor::after_step(const BodyStates& state, std::span<const ContactReco
 
 TowOutcome TowMonitor::outcome(const BodyStates& state, double time) const {
   TowOutcome o;
-  o.direction = tow_.direction();
+  o.direction = direction_;
   const Vec2 moved = state.position[tow_.body] - scene_.bodies[tow_.body].centroid;
   o.distance = dot(moved, o.direction);
   o.cross_track = cross(o.direction, moved);

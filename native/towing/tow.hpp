@@ -108,6 +108,7 @@ class TowMonitor {
  private:
   const Scene& scene_;
   const TowSpec& tow_;
+  Vec2 direction_;  ///< the tow's direction, along which the outcome and stalling are measured
   double time_ = 0.0;
   Vec2 force_, ice_;
   Vec2 sum_, ice_sum_;
