@@ -202,6 +202,8 @@ def quantile_plot(maxima, fit, ax):
 def table(rows, columns):
     """Rows (dicts) as a Markdown table a planner can paste, numbers to 4 significant figures."""
     def text(v):
+        if v is None:  # none (no pull reaches the odds): an empty cell
+            return ""
         if isinstance(v, float):
             return f"{v:.4g}"
         return str(v)

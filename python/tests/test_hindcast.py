@@ -55,3 +55,21 @@ def test_write_chart_closes_rings_and_writes_codes_as_text(tmp_path):
     assert not (tmp_path / "c.geojson.partial").exists()
     with pytest.raises(ValueError, match="feature 0: a ring needs at least 3 points"):
         floedem.chart.write_chart(tmp_path / "d.geojson", [{"lonlat": [(0, 0), (1, 1)], "CT": "10"}])
+
+
+def test_the_worked_towing_example_runs_and_its_plan_is_valid(tmp_path):
+    # docs/towing.md, "A worked example": the hindcast's iceberg in tow through the chart's ice.
+    for name in ("tow.toml", "tow_plan.toml"):
+        shutil.copy(os.path.join(EXAMPLE, name), tmp_path)
+    runpy.run_path(os.path.join(EXAMPLE, "make_forcing.py"))["main"](str(tmp_path))
+    out = str(tmp_path / "tow.h5")
+    subprocess.run([FLOEDEM, "run", str(tmp_path / "tow.toml"), "-o", out, "-q", "--set", "run.duration=300.0"],
+                   check=True)
+    with floedem.open(out) as run:
+        outcome = run.tow.outcome
+        assert not outcome["parted"]
+        assert outcome["distance"] > 0.0       # the tug has the iceberg moving east
+        assert run.tow.attrs["mode"] == "tug"
+    plan = subprocess.run([FLOEDEM, "sweep", str(tmp_path / "tow_plan.toml"), "--out", str(tmp_path / "plan"), "-n"],
+                          capture_output=True, text=True)
+    assert plan.returncode == 0, plan.stderr

@@ -86,6 +86,8 @@ def test_design_loads_bootstrap_interval_holds_the_true_level():
     assert rows[1]["hi"] - rows[1]["lo"] > rows[0]["hi"] - rows[0]["lo"]  # the longer period, the wider
     text = towing.table(rows, ["period", "level", "lo", "hi"])
     assert text.startswith("| period | level | lo | hi |") and text.count("\n") == 4
+    # None (no pull reaches the odds) is an empty cell, not the word
+    assert towing.table([dict(a=None, b=1.0)], ["a", "b"]).splitlines()[-1] == "|  | 1 |"
 
 
 TUG = """
