@@ -92,9 +92,18 @@ def smallest_pull(points, probability, conservative=True):
 
 
 #: The fewest maxima a GEV is fitted to: three parameters, and below ten maxima the shape is noise;
-#: and the fewest distinct ones among them.
+#: and the fewest distinct ones among them, told apart at DISTINCT_RESOLUTION of their mean: a
+#: line's largest tension, set by the tug taking up the iceberg before the ice counts, differs
+#: from seed to seed by parts in 10^5, a spread of round-off and not a tail to fit.
 MIN_MAXIMA = 10
 MIN_DISTINCT = 5
+DISTINCT_RESOLUTION = 1e-4
+
+
+def _distinct(x):
+    """How many of the values differ by more than DISTINCT_RESOLUTION of their mean magnitude."""
+    step = DISTINCT_RESOLUTION * float(np.mean(np.abs(x)))
+    return np.unique(np.round(x / step)).size if step > 0.0 else np.unique(x).size
 
 
 def _gev_nll(theta, z):
@@ -126,9 +135,9 @@ def gev_fit(maxima, start=None):
     x = np.asarray(maxima, float)
     if x.size < MIN_MAXIMA or not np.all(np.isfinite(x)):
         raise ValueError(f"gev_fit: needs at least {MIN_MAXIMA} finite maxima")
-    if np.unique(x).size < MIN_DISTINCT:
-        raise ValueError(f"gev_fit: fewer than {MIN_DISTINCT} distinct maxima; no spread to fit (a load the ice "
-                         "does not move, set by the tug alone)")
+    if _distinct(x) < MIN_DISTINCT:
+        raise ValueError(f"gev_fit: fewer than {MIN_DISTINCT} maxima distinct at {DISTINCT_RESOLUTION:g} of their "
+                         "mean; no spread to fit (a load the ice does not move, set by the tug alone)")
     m, s = float(np.mean(x)), float(np.std(x))
     z = (x - m) / s
     sigma0 = math.sqrt(6.0) / math.pi
@@ -168,7 +177,7 @@ def design_loads(maxima, periods=(10, 100), boot=400, confidence=0.95, seed=0):
     levels = {T: [] for T in periods}
     for _ in range(boot):
         sample = rng.choice(x, size=x.size, replace=True)
-        if np.unique(sample).size < MIN_DISTINCT:
+        if _distinct(sample) < MIN_DISTINCT:
             continue  # a resample of a few values has no spread to fit
         f = gev_fit(sample, start=fit)
         for T in periods:
@@ -356,7 +365,7 @@ def write_decisions(out, summaries, keys, decision):
             f"\nDesign loads (N): the line's largest tension (`tension_max`) and the largest collision peak force on "
             f"the towed body (`collision_max`) exceeded once in {' and '.join(T)} tows, from a GEV fit of the tows' "
             f"maxima with its bootstrap 95 % interval (nan: fewer than {MIN_MAXIMA} tows, or fewer than "
-            f"{MIN_DISTINCT} distinct maxima: a load the ice does not move):\n",
+            f"{MIN_DISTINCT} maxima distinct at {DISTINCT_RESOLUTION:g} of their mean: a load the ice does not move):\n",
             table(load_rows, ["engine"] + keys + loads)]
     if smallest:
         text += [f"\nThe smallest `{decision['pull']}` whose odds reach {decision['probability']:g} (the estimate, "

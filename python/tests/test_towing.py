@@ -73,6 +73,15 @@ def test_gev_fit_and_return_levels_on_a_gev_sample():
     assert towing.return_level(gumbel, 100) == pytest.approx(1.0 - 2.0 * math.log(-math.log(0.99)), rel=1e-12)
 
 
+def test_maxima_that_differ_by_round_off_get_no_fit():
+    # A line's largest tension set by the tug: 16 tows within parts in 10^5 of each other (as a
+    # planning sweep measures them) is one load, not a tail; a spread of 1 % is one to fit.
+    tug = 6.14e5 * (1.0 + 1e-5 * np.arange(16))
+    with pytest.raises(ValueError, match="distinct at 0.0001 of their mean"):
+        towing.gev_fit(tug)
+    towing.gev_fit(6.14e5 * (1.0 + 1e-2 * np.sin(np.arange(16))))
+
+
 def test_design_loads_bootstrap_interval_holds_the_true_level():
     # 48 tows (a planner's ensemble): the 10-tow load's 95 % interval holds the true one.
     from scipy.stats import genextreme
