@@ -237,7 +237,7 @@ IceChart read_ice_chart(const std::string& path, const std::string& layer_name, 
                        "; allowed rings that do not cross themselves or each other, holes inside their outer ring");
     std::vector<const OGRPolygon*> pieces;
     // The vertices are checked before the edges are cut into kMaxEdgeDeg pieces: a vertex at
-    // 1e7 deg would otherwise be cut into some 1e8 points before it could be refused.
+    // 1e7 deg would otherwise be cut into some 1e9 points before it could be refused.
     collect_polygons(g.get(), pieces);
     auto check_ring = [&](const OGRLinearRing& ring) {
       for (int k = 0; k < ring.getNumPoints(); ++k)

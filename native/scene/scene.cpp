@@ -10,8 +10,19 @@
 
 namespace floedem {
 
-std::string printable(std::string_view text, std::size_t max) {
+namespace {
+
+/// A byte as \xNN (two lowercase hex digits).
+void append_escaped(std::string& out, unsigned char c) {
   static constexpr char kHex[] = "0123456789abcdef";
+  out += "\\x";
+  out.push_back(kHex[c >> 4]);
+  out.push_back(kHex[c & 15]);
+}
+
+}  // namespace
+
+std::string printable(std::string_view text, std::size_t max) {
   std::string out;
   for (std::size_t k = 0; k < text.size(); ++k) {
     if (k == max) {
@@ -19,31 +30,26 @@ std::string printable(std::string_view text, std::size_t max) {
       break;
     }
     const auto c = static_cast<unsigned char>(text[k]);
-    if (c >= 0x20 && c < 0x7f) {
+    if (c >= 0x20 && c < 0x7f)
       out.push_back(static_cast<char>(c));
-    } else {
-      out += "\\x";
-      out.push_back(kHex[c >> 4]);
-      out.push_back(kHex[c & 15]);
-    }
+    else
+      append_escaped(out, c);
   }
   return out;
 }
 
 std::string one_line(const std::string& message) {
-  if (std::none_of(message.begin(), message.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
-    return message;
-  static constexpr char kHex[] = "0123456789abcdef";
+  const auto control = [](char ch) {
+    const auto c = static_cast<unsigned char>(ch);
+    return c < 0x20 || c == 0x7f;
+  };
+  if (std::none_of(message.begin(), message.end(), control)) return message;
   std::string out;
   for (char ch : message) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c < 0x20 || c == 0x7f) {
-      out += "\\x";
-      out.push_back(kHex[c >> 4]);
-      out.push_back(kHex[c & 15]);
-    } else {
+    if (control(ch))
+      append_escaped(out, static_cast<unsigned char>(ch));
+    else
       out.push_back(ch);
-    }
   }
   return out;
 }
