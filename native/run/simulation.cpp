@@ -168,14 +168,7 @@ class SceneRun {
       recorder_ = std::make_unique<Recorder>(options_.output, scene_, stepper_.engine().info(), info_);
       summary_.kinetic_energy_start = kinetic_energy(scene_, stepper_.state());
       summary_.max_kinetic_energy = summary_.kinetic_energy_start;
-      constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-      if (tow_.active()) {
-        TowFrame first;  // no step yet: no forces
-        first.force = first.force_mean = first.ice_force_mean = {nan, nan};
-        first.tug_position = tow_.tug_position(0.0);
-        first.tug_velocity = tow_.line().tug_velocity(scene_.tow, scene_.has_environment ? &scene_.environment : nullptr, 0.0);
-        recorder_->write_tow(0.0, first);
-      }
+      if (tow_.active()) recorder_->write_tow(0.0, tow_.start_frame());
       write_frame(0.0);
       return 1;
     }

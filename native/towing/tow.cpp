@@ -103,7 +103,7 @@ Vec2 TowMonitor::tug_position(double time) const {
 void TowMonitor::before_step(const BodyStates& state, double time) {
   time_ = time;
   if (!tow_.has_rope()) return;
-  rope_ = rope_state(tow_, line_, scene_.has_environment ? &scene_.environment : nullptr, state, time);
+  rope_ = rope_state(tow_, line_, water(), state, time);
   if (tow_.breaking_load > 0.0 && !line_.parted && rope_.tension > tow_.breaking_load) {
     line_.parted = true;
     line_.parted_at = time;
@@ -143,8 +143,7 @@ void TowMonitor::after_step(const BodyStates& state, std::span<const ContactReco
     const double rope = -rope_.tension * along;
     const double jacobian = slope - (rope_.tension > 0.0 ? (tow_.damping + dt * tow_.stiffness) * along * along : 0.0);
     line_.speed += dt * (pull + rope) / (tow_.tug_mass - dt * jacobian);
-    const EnvironmentSpec* water = scene_.has_environment ? &scene_.environment : nullptr;
-    line_.tug += dt * line_.tug_velocity(tow_, water, time_);
+    line_.tug += dt * line_.tug_velocity(tow_, water(), time_);
   }
   if (dot(state.velocity[tow_.body], direction_) < tow_.stall_speed) stalled_time_ += dt;
   sum_ += force_;
@@ -206,11 +205,20 @@ TowFrame TowMonitor::take_frame(double time) {
   f.ice_force_mean = count_ > 0 ? (1.0 / static_cast<double>(count_)) * ice_sum_ : ice_;
   f.tug_position = tug_position(time);
   f.tension_max = frame_tension_max_;
-  f.tug_velocity = line_.tug_velocity(tow_, scene_.has_environment ? &scene_.environment : nullptr, time);
+  f.tug_velocity = line_.tug_velocity(tow_, water(), time);
   sum_ = {};
   ice_sum_ = {};
   count_ = 0;
   frame_tension_max_ = 0.0;
+  return f;
+}
+
+TowFrame TowMonitor::start_frame() const {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  TowFrame f;
+  f.force = f.force_mean = f.ice_force_mean = {nan, nan};
+  f.tug_position = tug_position(0.0);
+  f.tug_velocity = line_.tug_velocity(tow_, water(), 0.0);
   return f;
 }
 

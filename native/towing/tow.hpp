@@ -98,6 +98,8 @@ class TowMonitor {
   const TowLine& line() const { return line_; }
   /// The frame at `time`: means over the steps since the last call (frames every k-th step).
   TowFrame take_frame(double time);
+  /// The frame at t = 0, before any step: no forces yet (NaN), the tug where and as it starts.
+  TowFrame start_frame() const;
   /// The outcome at the end of a run of `time` seconds, the body where `state` has it.
   TowOutcome outcome(const BodyStates& state, double time) const;
   /// Checkpoint: the last step's forces, the sums of the frame under way, the line and the
@@ -107,6 +109,9 @@ class TowMonitor {
 
  private:
   const Scene& scene_;
+  /// The water the tug moves through: the scene's environment, or none.
+  const EnvironmentSpec* water() const { return scene_.has_environment ? &scene_.environment : nullptr; }
+
   const TowSpec& tow_;
   Vec2 direction_;  ///< the tow's direction, along which the outcome and stalling are measured
   double time_ = 0.0;
